@@ -110,7 +110,7 @@ SRC
   log "configuring Trilinos (log: $work/configure.log)"
   rm -rf "$work/build" && mkdir -p "$work/build"
   (cd "$work/build" && cmake "$src" -DCMAKE_INSTALL_PREFIX="$prefix" \
-    -DCMAKE_CXX_COMPILER=g++ -DCMAKE_C_COMPILER=gcc "${TRILINOS_OPTIONS[@]}" >"$work/configure.log" 2>&1) ||
+    "${TRILINOS_OPTIONS[@]}" >"$work/configure.log" 2>&1) ||
     { tail -n 40 "$work/configure.log" >&2; exit 1; }
   log "building Trilinos with $(nproc) jobs: about 15 minutes on 2 cores (log: $work/build.log)"
   local t0=$SECONDS

@@ -1,0 +1,110 @@
+// Small geometric predicates used inside kernels: horizon test, bond/crack crossing, distance to
+// a crack. Plain functions of coordinates, callable on host and in Kokkos kernels.
+#ifndef MUPM_GEOMETRY_HPP
+#define MUPM_GEOMETRY_HPP
+
+#include <Kokkos_Core.hpp>
+
+namespace mupm {
+
+// A pre-crack: in 2D the segment a -> b (c unused); in 3D the rectangle with corner a and
+// orthogonal edges b and c.
+struct Crack {
+  double a[3] = {0, 0, 0};
+  double b[3] = {0, 0, 0};
+  double c[3] = {0, 0, 0};
+};
+
+// An axis-aligned box [lo, hi] (closed).
+struct Box {
+  double lo[3] = {0, 0, 0};
+  double hi[3] = {0, 0, 0};
+};
+
+// |xi|^2 <= delta^2, with a relative slack so that delta = 3 dx exactly keeps the points at 3 dx
+// whatever the rounding of the coordinates.
+KOKKOS_INLINE_FUNCTION bool within_horizon(double d2, double delta2) {
+  return d2 <= delta2 * (1.0 + 1e-10);
+}
+
+template <int Dim>
+KOKKOS_INLINE_FUNCTION bool in_box(const Box& b, const double* x, double tol) {
+  for (int d = 0; d < Dim; ++d)
+    if (x[d] < b.lo[d] - tol || x[d] > b.hi[d] + tol) return false;
+  return true;
+}
+
+KOKKOS_INLINE_FUNCTION double orient2d(const double* a, const double* b, const double* p) {
+  return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+}
+
+// Does the bond p -> q cross the crack? The two ends must lie strictly on opposite sides of the
+// crack line (plane); the crossing point may touch the crack's edge. A point lying exactly on the
+// crack is therefore on neither side: place cracks between lattice lines.
+template <int Dim>
+KOKKOS_INLINE_FUNCTION bool bond_crosses(const Crack& c, const double* p, const double* q) {
+  if constexpr (Dim == 2) {
+    const double d1 = orient2d(c.a, c.b, p);
+    const double d2 = orient2d(c.a, c.b, q);
+    if (!(d1 * d2 < 0.0)) return false;
+    const double d3 = orient2d(p, q, c.a);
+    const double d4 = orient2d(p, q, c.b);
+    return d3 * d4 <= 0.0;
+  } else {
+    const double n[3] = {c.b[1] * c.c[2] - c.b[2] * c.c[1], c.b[2] * c.c[0] - c.b[0] * c.c[2],
+                         c.b[0] * c.c[1] - c.b[1] * c.c[0]};
+    double sp = 0, sq = 0;
+    for (int d = 0; d < 3; ++d) {
+      sp += n[d] * (p[d] - c.a[d]);
+      sq += n[d] * (q[d] - c.a[d]);
+    }
+    if (!(sp * sq < 0.0)) return false;
+    const double t = sp / (sp - sq);
+    double s1 = 0, s2 = 0, e1 = 0, e2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double xd = p[d] + t * (q[d] - p[d]) - c.a[d];
+      s1 += xd * c.b[d];
+      s2 += xd * c.c[d];
+      e1 += c.b[d] * c.b[d];
+      e2 += c.c[d] * c.c[d];
+    }
+    const double tol = 1e-12;
+    return s1 >= -tol * e1 && s1 <= (1 + tol) * e1 && s2 >= -tol * e2 && s2 <= (1 + tol) * e2;
+  }
+}
+
+// Squared distance from x to the crack segment (2D) or rectangle (3D).
+template <int Dim>
+KOKKOS_INLINE_FUNCTION double distance2_to_crack(const Crack& c, const double* x) {
+  if constexpr (Dim == 2) {
+    const double e[2] = {c.b[0] - c.a[0], c.b[1] - c.a[1]};
+    const double r[2] = {x[0] - c.a[0], x[1] - c.a[1]};
+    const double ee = e[0] * e[0] + e[1] * e[1];
+    double t = ee > 0 ? (r[0] * e[0] + r[1] * e[1]) / ee : 0.0;
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    const double dx = r[0] - t * e[0], dy = r[1] - t * e[1];
+    return dx * dx + dy * dy;
+  } else {
+    double r[3], s1 = 0, s2 = 0, e1 = 0, e2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      r[d] = x[d] - c.a[d];
+      s1 += r[d] * c.b[d];
+      s2 += r[d] * c.c[d];
+      e1 += c.b[d] * c.b[d];
+      e2 += c.c[d] * c.c[d];
+    }
+    double t1 = e1 > 0 ? s1 / e1 : 0, t2 = e2 > 0 ? s2 / e2 : 0;
+    t1 = t1 < 0 ? 0 : (t1 > 1 ? 1 : t1);
+    t2 = t2 < 0 ? 0 : (t2 > 1 ? 1 : t2);
+    double d2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double dd = r[d] - t1 * c.b[d] - t2 * c.c[d];
+      d2 += dd * dd;
+    }
+    return d2;
+  }
+}
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,82 @@
+// Google Benchmark of the bond infrastructure on one rank: the neighbour build (cell binning,
+// count -> scan -> fill, rows sorted by global id) and a bond loop that gathers neighbour data
+// (the shape tensor of pass 1, eq 45), in 2D and 3D at delta = 3.015 dx and 4.015 dx.
+// Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads ./perf/bench_bonds
+#include <benchmark/benchmark.h>
+
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <Tpetra_Core.hpp>
+
+#include "mupm/discretization.hpp"
+#include "mupm/shape_tensor.hpp"
+
+namespace {
+
+using namespace mupm;
+
+Teuchos::RCP<const Comm> self() { return Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF)); }
+
+template <int Dim>
+GridSpec<Dim> grid(long long n_per_axis, double factor) {
+  GridSpec<Dim> g;
+  g.counts.fill(n_per_axis);
+  g.dx = 1e-3;
+  g.horizon = factor * g.dx;
+  return g;
+}
+
+// state.range(0): points per axis; state.range(1): horizon factor x 1000.
+template <int Dim>
+void BM_NeighborBuild(benchmark::State& state) {
+  const auto g = grid<Dim>(state.range(0), state.range(1) / 1000.0);
+  auto disc = discretize(self(), g);
+  for (auto _ : state) {
+    auto bonds = build_bonds(disc.points, g.horizon, g.cracks);
+    Kokkos::fence();
+    benchmark::DoNotOptimize(bonds.neighbor.data());
+  }
+  const double n_bonds = double(disc.bonds.size()), n_points = double(disc.points.n_owned);
+  state.counters["points"] = n_points;
+  state.counters["bonds_per_point"] = n_bonds / n_points;
+  state.counters["bond_updates_per_s"] =
+      benchmark::Counter(n_bonds, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["points_per_s"] =
+      benchmark::Counter(n_points, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+template <int Dim>
+void BM_ShapeTensorBondLoop(benchmark::State& state) {
+  const auto g = grid<Dim>(state.range(0), state.range(1) / 1000.0);
+  auto disc = discretize(self(), g);
+  Vectors K("K", disc.points.n_owned, Dim * Dim);
+  compute_shape_tensor(disc.points, disc.bonds, K);  // warm-up
+  Kokkos::fence();
+  for (auto _ : state) {
+    compute_shape_tensor(disc.points, disc.bonds, K);
+    Kokkos::fence();
+  }
+  const double n_bonds = double(disc.bonds.size()), n_points = double(disc.points.n_owned);
+  state.counters["points"] = n_points;
+  state.counters["bytes_per_bond"] = double(disc.bonds.bytes_per_bond());
+  state.counters["bytes_per_point"] = double(Points<Dim>::bytes_per_point());
+  state.counters["bond_updates_per_s"] =
+      benchmark::Counter(n_bonds, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["points_per_s"] =
+      benchmark::Counter(n_points, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+BENCHMARK_TEMPLATE(BM_NeighborBuild, 2)->Args({400, 3015})->Args({400, 4015})->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_NeighborBuild, 3)->Args({50, 3015})->Args({50, 4015})->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_ShapeTensorBondLoop, 2)->Args({400, 3015})->Args({400, 4015})->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_ShapeTensorBondLoop, 3)->Args({50, 3015})->Args({50, 4015})->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Tpetra::ScopeGuard scope(&argc, &argv);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

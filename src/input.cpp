@@ -1,0 +1,531 @@
+#include "mupm/input.hpp"
+
+#include <Teuchos_Array.hpp>
+#include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <Teuchos_XMLParameterListCoreHelpers.hpp>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace mupm {
+
+namespace {
+
+using Teuchos::Array;
+using Teuchos::ParameterList;
+using Teuchos::RCP;
+using Teuchos::rcp;
+
+const std::vector<std::string> kIcFields = {"Displacement",   "Velocity",        "Micro-Rotation",
+                                            "Micro-Rotation Rate", "Pore Pressure",
+                                            "Fracture Pressure", "Porosity",    "Saturation"};
+const std::vector<std::string> kFaces = {"-x", "+x", "-y", "+y", "-z", "+z"};
+
+template <class T>
+RCP<Teuchos::EnhancedNumberValidator<T>> at_least(T lo) {
+  return rcp(new Teuchos::EnhancedNumberValidator<T>(lo, std::numeric_limits<T>::max()));
+}
+RCP<Teuchos::EnhancedNumberValidator<double>> positive() {
+  return at_least(std::numeric_limits<double>::min());
+}
+RCP<Teuchos::StringValidator> one_of(const std::vector<std::string>& v) {
+  return rcp(new Teuchos::StringValidator(Array<std::string>(v.begin(), v.end())));
+}
+
+void region_template(ParameterList& r) {
+  r.set("Min", Array<double>(), "Lower corner of the box [m] (Dim values, closed).");
+  r.set("Max", Array<double>(), "Upper corner of the box [m] (Dim values, closed).");
+}
+void crack_template(ParameterList& c) {
+  c.set("Start", Array<double>(), "2D: first end of the crack segment [m].");
+  c.set("End", Array<double>(), "2D: second end of the crack segment [m].");
+  c.set("Corner", Array<double>(), "3D: a corner of the crack rectangle [m].");
+  c.set("Edge 1", Array<double>(), "3D: first edge vector of the rectangle from Corner [m].");
+  c.set("Edge 2", Array<double>(),
+        "3D: second edge vector of the rectangle from Corner [m], orthogonal to Edge 1.");
+}
+void ic_template(ParameterList& c) {
+  c.set("Field", std::string("Velocity"),
+        "Field to set: Displacement, Velocity (Dim values), Micro-Rotation, Micro-Rotation Rate "
+        "(1 value in 2D, 3 in 3D), Pore Pressure [Pa], Fracture Pressure [Pa], Porosity, "
+        "Saturation (1 value).",
+        one_of(kIcFields));
+  c.set("Region", std::string("All"),
+        "Name of a region of Discretization->Regions, or All. Later conditions overwrite "
+        "earlier ones where they overlap.");
+  c.set("Value", Array<double>(), "The value (number of entries as Field says).");
+}
+
+// The user-named sublists: validated against their template one by one, not by Teuchos'
+// recursion.
+const std::vector<std::pair<std::string, void (*)(ParameterList&)>> kNamedSublists = {
+    {"Regions", region_template}, {"Pre-Cracks", crack_template}};
+
+}  // namespace
+
+const std::vector<std::string>& output_field_names() {
+  static const std::vector<std::string> names = {
+      "displacement", "velocity",  "acceleration",   "micro_rotation", "micro_rotation_rate",
+      "pore_pressure", "fracture_pressure", "porosity", "saturation",   "damage",
+      "fracture",      "flags",     "regions",        "stress",         "couple_stress",
+      "plastic_strain"};
+  return names;
+}
+
+RCP<ParameterList> valid_parameters() {
+  auto pl = rcp(new ParameterList("mupm"));
+  {
+    ParameterList& d = pl->sublist("Discretization", false,
+                                   "The point grid: a box of cell-centred points of spacing "
+                                   "Spacing, boundary layers, pre-cracks and named regions.");
+    d.set("Dimension", 2, "2 (plane strain) or 3.",
+          rcp(new Teuchos::EnhancedNumberValidator<int>(2, 3)));
+    d.set("Spacing", 1.0, "Point spacing dx [m] (required, > 0).", positive());
+    d.set("Counts", Array<int>(),
+          "Number of points of the real body along each axis (Dim values >= 1). Give Counts "
+          "or Extents.",
+          rcp(new Teuchos::ArrayNumberValidator<int>(at_least(1))));
+    d.set("Extents", Array<double>(),
+          "Size of the real body along each axis [m] (Dim values, each a whole multiple of "
+          "Spacing). Give Counts or Extents.");
+    d.set("Origin", Array<double>(), "Lower corner of the real body [m] (Dim values; default 0).");
+    d.set("Horizon Factor", 3.015,
+          "Horizon delta as a multiple of Spacing (used unless Horizon is given).", positive());
+    d.set("Horizon", 0.0, "Horizon delta [m]; 0: use Horizon Factor. Give one of the two.",
+          at_least(0.0));
+    d.set("Thickness", 1.0, "Out-of-plane thickness [m] (2D only).", positive());
+    d.set("Boundary Layers", Array<std::string>(),
+          "Faces of the body that get a boundary layer of floor(delta/dx) rows of fictitious "
+          "points outside them (the paper's boundary-layer method), any of -x +x -y +y -z +z. "
+          "Each layer is also a region named 'Layer -y' etc.",
+          rcp(new Teuchos::ArrayStringValidator(one_of(kFaces))));
+    ParameterList& r = d.sublist("Regions", false,
+                                 "Named boxes for boundary and initial conditions and outputs: "
+                                 "one sublist per region, named as you like (at most 24).");
+    region_template(r.sublist("NAME"));
+    ParameterList& c = d.sublist("Pre-Cracks", false,
+                                 "Initial cracks, one sublist each: a segment (Start, End) in 2D, "
+                                 "a rectangle (Corner, Edge 1, Edge 2) in 3D. Bonds crossing a "
+                                 "crack start broken; points closer than Spacing to it start as "
+                                 "fracture points.");
+    crack_template(c.sublist("NAME"));
+  }
+  pl->sublist("Materials", false, "Solid constitutive models (filled by the solid-mechanics issue).");
+  pl->sublist("Fluid", false, "Pore fluid properties (filled by the pore-fluid issue).");
+  pl->sublist("Fracture", false, "Bond breakage and fracture flow (filled by the fracture issue).");
+  pl->sublist("Boundary Conditions", false,
+              "Prescribed fields on regions (filled by the solid-mechanics issue).");
+  {
+    ParameterList& ic = pl->sublist("Initial Conditions", false,
+                                    "Initial fields, one sublist per condition, named as you "
+                                    "like, applied in the order given.");
+    ic_template(ic.sublist("NAME"));
+  }
+  {
+    ParameterList& s = pl->sublist("Solver", false, "Time stepping.");
+    s.set("Physics", std::string("Kinematics Only"),
+          "Physics advanced each step. 'Kinematics Only' (the only model so far): no internal "
+          "forces; displacement advances with the velocity by central difference, damage is "
+          "kept from the intact bonds (eq 37). Solid, fluid and fracture models come with later "
+          "issues.",
+          one_of({"Kinematics Only"}));
+    s.set("Time Step", 1e-6, "Time step dt [s] (> 0).", positive());
+    s.set("Number of Steps", 100, "Number of time steps (>= 0).", at_least(0));
+    s.set("Restart From", std::string(""),
+          "Checkpoint file (.h5) to continue from; empty: start at t = 0. The run may use a "
+          "different number of ranks and threads than the one that wrote it.");
+  }
+  {
+    ParameterList& o = pl->sublist("Output", false, "Files written to Output->Folder.");
+    o.set("Folder", std::string("output"), "Output folder (created if missing).");
+    o.set("Field Interval", 10,
+          "Steps between point-field outputs (HDF5 + XDMF); 0: first and last step only.",
+          at_least(0));
+    o.set("Fields", Array<std::string>({"displacement", "velocity", "damage", "fracture"}),
+          "Point fields written at each field output. Any of: displacement, velocity, "
+          "acceleration, micro_rotation, micro_rotation_rate, pore_pressure, fracture_pressure, "
+          "porosity, saturation, damage, fracture, flags, regions, stress, couple_stress, "
+          "plastic_strain. Global id and reference position are always written.",
+          rcp(new Teuchos::ArrayStringValidator(one_of(output_field_names()))));
+    o.set("Time Series Interval", 1, "Steps between rows of time_series.csv (>= 1).",
+          at_least(1));
+    o.set("Checkpoint Interval", 0, "Steps between checkpoints; 0: none during the run.",
+          at_least(0));
+    o.set("Checkpoint At End", true, "Write a checkpoint after the last step.");
+    o.set("Progress Interval", 5.0,
+          "Wall-clock seconds between progress lines (step, time, ETA); 0: every step.",
+          at_least(0.0));
+  }
+  {
+    ParameterList& g = pl->sublist("Diagnostics", false, "Checks and reports.");
+    g.set("Kernel Timers", true,
+          "Print the per-kernel time table (min/max over ranks) at the end of the run.");
+    g.set("Check Finite", true,
+          "Stop the run when a field holds NaN or Inf, naming the step, global id and position.");
+  }
+  return pl;
+}
+
+namespace {
+
+std::string path_of(const ParameterList& list, const std::string& name) {
+  return list.name() + "->" + name;
+}
+
+// Teuchos' messages name the (sub)list and the entry and list what is valid; keep them, and
+// drop the preamble and the "Throw number" trailer.
+std::string clean_teuchos(const std::exception& e) {
+  std::string msg = e.what();
+  const auto pos = msg.find("Error");
+  if (pos != std::string::npos && pos > 0) msg = msg.substr(pos);
+  const auto tr = msg.find("Throw number");
+  if (tr != std::string::npos) msg = msg.substr(0, tr);
+  while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' ')) msg.pop_back();
+  return msg;
+}
+
+// The XML reader names the root "ANONYMOUS"; give every list its full path from "mupm".
+void name_lists(ParameterList& list, const std::string& path) {
+  list.setName(path);
+  for (auto it = list.begin(); it != list.end(); ++it)
+    if (list.entry(it).isList()) name_lists(list.sublist(list.name(it)), path + "->" + list.name(it));
+}
+
+void validate_level(ParameterList& list, const ParameterList& valid) {
+  // Sublists whose children are user-named are checked entry by entry against "NAME".
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string& name = list.name(it);
+    const auto* ventry = valid.getEntryPtr(name);
+    if (ventry && ventry->isList() && list.entry(it).isList() &&
+        Teuchos::getValue<ParameterList>(*ventry).isSublist("NAME")) {
+      ParameterList& user = list.sublist(name);
+      const ParameterList& tmpl = Teuchos::getValue<ParameterList>(*ventry).sublist("NAME");
+      for (auto jt = user.begin(); jt != user.end(); ++jt) {
+        const std::string& child = user.name(jt);
+        if (!user.entry(jt).isList())
+          throw InputError("Error, " + path_of(user, child) +
+                           " is a parameter, but here every entry must be a sublist (one per "
+                           "named item) with the parameters: " +
+                           tmpl.currentParametersString());
+        validate_level(user.sublist(child), tmpl);
+      }
+    }
+  }
+  // This level: names, types and ranges (Teuchos), then defaults; recursion into the fixed
+  // sublists below.
+  ParameterList shallow(valid.name());
+  for (auto it = valid.begin(); it != valid.end(); ++it) {
+    const std::string& name = valid.name(it);
+    if (valid.entry(it).isList()) {
+      ParameterList& s = shallow.sublist(name);
+      if (Teuchos::getValue<ParameterList>(valid.entry(it)).isSublist("NAME"))
+        s.disableRecursiveValidation();
+    } else {
+      shallow.setEntry(name, valid.entry(it));
+    }
+  }
+  // Validators' own messages do not say where the entry is: add its full path.
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const auto* ventry = valid.getEntryPtr(list.name(it));
+    if (!ventry || ventry->isList() || list.entry(it).isList()) continue;
+    const auto& any = list.entry(it).getAny(false);
+    if (any.type() != ventry->getAny(false).type())
+      throw InputError("Error, " + path_of(list, list.name(it)) + " has type \"" +
+                       any.typeName() + "\" (value \"" + Teuchos::toString(any) +
+                       "\"); the expected type is \"" + ventry->getAny(false).typeName() +
+                       "\": " + ventry->docString());
+    if (ventry->validator().is_null()) continue;
+    try {
+      ventry->validator()->validate(list.entry(it), list.name(it), list.name());
+    } catch (const std::exception& e) {
+      throw InputError("Error, " + path_of(list, list.name(it)) + " = " +
+                       Teuchos::toString(list.entry(it).getAny(false)) +
+                       " is not valid: " + clean_teuchos(e));
+    }
+  }
+  try {
+    list.validateParameters(shallow, 0);
+  } catch (const std::exception& e) {
+    throw InputError(clean_teuchos(e));
+  }
+  for (auto it = valid.begin(); it != valid.end(); ++it) {
+    const std::string& name = valid.name(it);
+    if (!valid.entry(it).isList()) {
+      // A filled-in default is marked as such (isDefault), without the validator, so the
+      // resolved list written back is plain values.
+      if (!list.isParameter(name)) {
+        Teuchos::ParameterEntry e;
+        e.setAnyValue(valid.entry(it).getAny(false), true);
+        e.setDocString(valid.entry(it).docString());
+        list.setEntry(name, e);
+      }
+      continue;
+    }
+    ParameterList& sub = list.sublist(name);
+    const ParameterList& vsub = Teuchos::getValue<ParameterList>(valid.entry(it));
+    if (vsub.isSublist("NAME")) continue;  // children checked above
+    validate_level(sub, vsub);
+  }
+}
+
+template <class T>
+Array<T> get_array(const ParameterList& l, const std::string& name, std::size_t n,
+                   const std::string& what) {
+  Array<T> a = l.get<Array<T>>(name);
+  if (static_cast<std::size_t>(a.size()) != n) {
+    std::ostringstream s;
+    s << "Error, " << path_of(l, name) << " must hold " << n << " values (" << what << "), not "
+      << a.size() << ".";
+    throw InputError(s.str());
+  }
+  return a;
+}
+
+void check_dimension_arrays(ParameterList& input) {
+  ParameterList& d = input.sublist("Discretization");
+  const int dim = d.get<int>("Dimension");
+  const bool has_counts = !d.get<Array<int>>("Counts").empty();
+  const bool has_extents = !d.get<Array<double>>("Extents").empty();
+  if (has_counts == has_extents)
+    throw InputError("Error, " + d.name() +
+                     " needs exactly one of Counts (points per axis) and Extents (body size "
+                     "in m), each with " + std::to_string(dim) + " values.");
+  if (has_counts) get_array<int>(d, "Counts", dim, "points per axis");
+  if (has_extents) {
+    const auto ext = get_array<double>(d, "Extents", dim, "body size per axis in m");
+    const double dx = d.get<double>("Spacing");
+    for (double e : ext) {
+      const double n = e / dx;
+      if (!(n >= 1) || std::abs(n - std::round(n)) > 1e-6 * n)
+        throw InputError("Error, " + path_of(d, "Extents") + " = " + std::to_string(e) +
+                         " is not a positive whole multiple of Spacing = " +
+                         std::to_string(dx) + ".");
+    }
+  }
+  if (!d.get<Array<double>>("Origin").empty()) get_array<double>(d, "Origin", dim, "m");
+  if (d.get<double>("Horizon") > 0 && d.isParameter("Horizon Factor") &&
+      !d.getEntry("Horizon Factor").isDefault())
+    throw InputError("Error, " + d.name() +
+                     " gives both Horizon and Horizon Factor: give one of the two.");
+  const Array<std::string> faces = d.get<Array<std::string>>("Boundary Layers");
+  for (const auto& f : faces)
+    if (f.size() == 2 && (f[1] - 'x') >= dim)
+      throw InputError("Error, " + path_of(d, "Boundary Layers") + " names face " + f +
+                       ", which a " + std::to_string(dim) + "D body does not have.");
+  ParameterList& regions = d.sublist("Regions");
+  int n_regions = 0;
+  for (auto it = regions.begin(); it != regions.end(); ++it, ++n_regions) {
+    ParameterList& r = regions.sublist(regions.name(it));
+    const auto lo = get_array<double>(r, "Min", dim, "lower corner in m");
+    const auto hi = get_array<double>(r, "Max", dim, "upper corner in m");
+    for (int k = 0; k < dim; ++k)
+      if (hi[k] < lo[k])
+        throw InputError("Error, " + r.name() + ": Max must not be below Min on any axis.");
+  }
+  if (n_regions + 2 * dim > 32)
+    throw InputError("Error, " + regions.name() + " holds " + std::to_string(n_regions) +
+                     " regions; at most " + std::to_string(32 - 2 * dim) + " are supported.");
+  ParameterList& cracks = d.sublist("Pre-Cracks");
+  for (auto it = cracks.begin(); it != cracks.end(); ++it) {
+    ParameterList& c = cracks.sublist(cracks.name(it));
+    if (dim == 2) {
+      get_array<double>(c, "Start", 2, "2D crack segment start in m");
+      get_array<double>(c, "End", 2, "2D crack segment end in m");
+      for (const char* k : {"Corner", "Edge 1", "Edge 2"})
+        if (!c.get<Array<double>>(k).empty())
+          throw InputError("Error, " + path_of(c, k) + " is for 3D cracks; use Start and End.");
+    } else {
+      get_array<double>(c, "Corner", 3, "3D crack rectangle corner in m");
+      const auto e1 = get_array<double>(c, "Edge 1", 3, "edge vector in m");
+      const auto e2 = get_array<double>(c, "Edge 2", 3, "edge vector in m");
+      const double dot = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
+      const double n1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+      const double n2 = std::sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+      if (n1 == 0 || n2 == 0 || std::abs(dot) > 1e-9 * n1 * n2)
+        throw InputError("Error, " + c.name() +
+                         ": Edge 1 and Edge 2 must be non-zero and orthogonal.");
+      for (const char* k : {"Start", "End"})
+        if (!c.get<Array<double>>(k).empty())
+          throw InputError("Error, " + path_of(c, k) +
+                           " is for 2D cracks; use Corner, Edge 1 and Edge 2.");
+    }
+  }
+  ParameterList& ics = input.sublist("Initial Conditions");
+  for (auto it = ics.begin(); it != ics.end(); ++it) {
+    ParameterList& c = ics.sublist(ics.name(it));
+    const std::string field = c.get<std::string>("Field");
+    const std::size_t n = (field == "Displacement" || field == "Velocity") ? dim
+                          : (field == "Micro-Rotation" || field == "Micro-Rotation Rate")
+                              ? (dim == 2 ? 1 : 3)
+                              : 1;
+    get_array<double>(c, "Value", n, field);
+    const std::string region = c.get<std::string>("Region");
+    bool known = region == "All" || regions.isSublist(region);
+    for (const auto& f : faces) known = known || region == "Layer " + f;
+    if (!known)
+      throw InputError("Error, " + path_of(c, "Region") + " = '" + region +
+                       "' names no region; expected All, a sublist of " + regions.name() +
+                       " or a boundary layer such as 'Layer -y'.");
+  }
+}
+
+}  // namespace
+
+RCP<ParameterList> parse_input(const std::string& xml) {
+  try {
+    auto pl = Teuchos::getParametersFromXmlString(xml);
+    name_lists(*pl, "mupm");
+    return pl;
+  } catch (const std::exception& e) {
+    throw InputError(std::string("Error, the input is not a valid Teuchos XML parameter list: ") +
+                     e.what());
+  }
+}
+
+RCP<ParameterList> read_input(const Teuchos::Comm<int>& comm, const std::string& path) {
+  std::string text;
+  int ok = 1;
+  if (comm.getRank() == 0) {
+    std::ifstream f(path);
+    if (!f) {
+      ok = 0;
+    } else {
+      std::ostringstream s;
+      s << f.rdbuf();
+      text = s.str();
+    }
+  }
+  Teuchos::broadcast(comm, 0, &ok);
+  if (!ok) throw InputError("Error, cannot read the input file '" + path + "'.");
+  long long n = static_cast<long long>(text.size());
+  Teuchos::broadcast(comm, 0, &n);
+  text.resize(static_cast<std::size_t>(n));
+  if (n > 0) Teuchos::broadcast(comm, 0, static_cast<int>(n), &text[0]);
+  return parse_input(text);
+}
+
+void validate_input(ParameterList& input) {
+  if (input.isSublist("Discretization") &&
+      !input.sublist("Discretization").isParameter("Spacing"))
+    throw InputError("Error, the required parameter " + input.name() +
+                     "->Discretization->Spacing (point spacing in m, a double > 0) is missing.");
+  if (!input.isSublist("Discretization"))
+    throw InputError("Error, the required sublist " + input.name() +
+                     "->Discretization is missing.");
+  validate_level(input, *valid_parameters());
+  check_dimension_arrays(input);
+}
+
+int input_dimension(const ParameterList& input) {
+  return input.sublist("Discretization").get<int>("Dimension");
+}
+
+template <int Dim>
+GridSpec<Dim> grid_from_input(const ParameterList& input) {
+  const ParameterList& d = input.sublist("Discretization");
+  GridSpec<Dim> g;
+  g.dx = d.get<double>("Spacing");
+  const double h = d.get<double>("Horizon");
+  g.horizon = h > 0 ? h : d.get<double>("Horizon Factor") * g.dx;
+  g.thickness = Dim == 2 ? d.get<double>("Thickness") : 1.0;
+  const auto counts = d.get<Array<int>>("Counts");
+  const auto ext = d.get<Array<double>>("Extents");
+  const auto origin = d.get<Array<double>>("Origin");
+  for (int k = 0; k < Dim; ++k) {
+    g.counts[k] = counts.empty() ? std::llround(ext[k] / g.dx) : counts[k];
+    g.origin[k] = origin.empty() ? 0.0 : origin[k];
+  }
+  const int rows = g.layer_rows();
+  for (const auto& f : d.get<Array<std::string>>("Boundary Layers"))
+    g.layers[f[1] - 'x'][f[0] == '-' ? 0 : 1] = rows;
+  const ParameterList& regions = d.sublist("Regions");
+  for (auto it = regions.begin(); it != regions.end(); ++it) {
+    const ParameterList& r = regions.sublist(regions.name(it));
+    Box b;
+    const auto lo = r.get<Array<double>>("Min"), hi = r.get<Array<double>>("Max");
+    for (int k = 0; k < Dim; ++k) {
+      b.lo[k] = lo[k];
+      b.hi[k] = hi[k];
+    }
+    g.region_names.push_back(regions.name(it));
+    g.regions.push_back(b);
+  }
+  // Boundary layers as regions: the rows outside the face, across the whole lattice.
+  for (int k = 0; k < Dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      if (g.layers[k][side] == 0) continue;
+      Box b;
+      for (int j = 0; j < Dim; ++j) {
+        b.lo[j] = g.origin[j] - (g.layers[j][0] + 1) * g.dx;
+        b.hi[j] = g.origin[j] + (g.counts[j] + g.layers[j][1] + 1) * g.dx;
+      }
+      const double lo_face = g.origin[k], hi_face = g.origin[k] + g.counts[k] * g.dx;
+      if (side == 0) b.hi[k] = lo_face - 0.25 * g.dx;
+      else b.lo[k] = hi_face + 0.25 * g.dx;
+      g.region_names.push_back(std::string("Layer ") + (side ? '+' : '-') + char('x' + k));
+      g.regions.push_back(b);
+    }
+  const ParameterList& cracks = d.sublist("Pre-Cracks");
+  for (auto it = cracks.begin(); it != cracks.end(); ++it) {
+    const ParameterList& c = cracks.sublist(cracks.name(it));
+    Crack cr;
+    if (Dim == 2) {
+      const auto a = c.get<Array<double>>("Start"), b = c.get<Array<double>>("End");
+      for (int k = 0; k < 2; ++k) {
+        cr.a[k] = a[k];
+        cr.b[k] = b[k];
+      }
+    } else {
+      const auto a = c.get<Array<double>>("Corner"), e1 = c.get<Array<double>>("Edge 1"),
+                 e2 = c.get<Array<double>>("Edge 2");
+      for (int k = 0; k < 3; ++k) {
+        cr.a[k] = a[k];
+        cr.b[k] = e1[k];
+        cr.c[k] = e2[k];
+      }
+    }
+    g.cracks.push_back(cr);
+  }
+  return g;
+}
+
+template GridSpec<2> grid_from_input<2>(const ParameterList&);
+template GridSpec<3> grid_from_input<3>(const ParameterList&);
+
+std::vector<InitialCondition> initial_conditions_from_input(const ParameterList& input) {
+  const ParameterList& d = input.sublist("Discretization");
+  std::vector<std::string> names;
+  const ParameterList& regions = d.sublist("Regions");
+  for (auto it = regions.begin(); it != regions.end(); ++it) names.push_back(regions.name(it));
+  const int dim = d.get<int>("Dimension");
+  // Same order as grid_from_input appends the layer regions.
+  const auto faces = d.get<Array<std::string>>("Boundary Layers");
+  for (int k = 0; k < dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      const std::string f = std::string(side ? "+" : "-") + char('x' + k);
+      for (const auto& g : faces)
+        if (g == f) {
+          names.push_back("Layer " + f);
+          break;
+        }
+    }
+  std::vector<InitialCondition> out;
+  const ParameterList& ics = input.sublist("Initial Conditions");
+  for (auto it = ics.begin(); it != ics.end(); ++it) {
+    const ParameterList& c = ics.sublist(ics.name(it));
+    InitialCondition ic;
+    ic.name = ics.name(it);
+    ic.field = c.get<std::string>("Field");
+    const std::string region = c.get<std::string>("Region");
+    for (std::size_t r = 0; r < names.size(); ++r)
+      if (names[r] == region) ic.region_mask = 1u << r;
+    const auto v = c.get<Array<double>>("Value");
+    ic.value.assign(v.begin(), v.end());
+    out.push_back(ic);
+  }
+  return out;
+}
+
+}  // namespace mupm

@@ -1,0 +1,80 @@
+// mupm: micro-periporomechanics simulations driven by a Teuchos XML input.
+#include <Teuchos_DefaultComm.hpp>
+#include <Teuchos_XMLParameterListCoreHelpers.hpp>
+#include <Tpetra_Core.hpp>
+#include <cstring>
+#include <iostream>
+
+#include "mupm/input.hpp"
+#include "mupm/simulation.hpp"
+
+namespace {
+
+const char* kUsage =
+    "usage: mupm INPUT.xml              run the simulation described by INPUT.xml\n"
+    "       mupm --validate INPUT.xml   check the input only (exit 0 when valid)\n"
+    "       mupm --print-defaults       print every parameter with its default and doc string\n"
+    "       mupm --help                 this text\n"
+    "Parallel: mpirun -np R mupm INPUT.xml, with OMP_NUM_THREADS=T threads per rank\n"
+    "(also OMP_PROC_BIND=spread OMP_PLACES=threads). Kokkos options (--kokkos-...) are accepted.\n"
+    "Exit codes: 0 success, 1 usage, 2 input error, 3 run-time error.\n";
+
+}  // namespace
+
+int main(int argc, char* argv[]) {
+  Tpetra::ScopeGuard scope(&argc, &argv);
+  auto comm = Tpetra::getDefaultComm();
+  const bool root = comm->getRank() == 0;
+  std::string mode = "run", path;
+  for (int k = 1; k < argc; ++k) {
+    const std::string a = argv[k];
+    if (a == "--help" || a == "-h") {
+      mode = "help";
+    } else if (a == "--print-defaults") {
+      mode = "defaults";
+    } else if (a == "--validate") {
+      mode = "validate";
+    } else if (!a.empty() && a[0] == '-') {
+      if (root) std::cerr << "mupm: unknown option " << a << "\n" << kUsage;
+      return 1;
+    } else if (path.empty()) {
+      path = a;
+    } else {
+      if (root) std::cerr << "mupm: more than one input file given\n" << kUsage;
+      return 1;
+    }
+  }
+  if (mode == "help") {
+    if (root) std::cout << kUsage;
+    return 0;
+  }
+  if (mode == "defaults") {
+    if (root) Teuchos::writeParameterListToXmlOStream(*mupm::valid_parameters(), std::cout);
+    return 0;
+  }
+  if (path.empty()) {
+    if (root) std::cerr << "mupm: no input file given\n" << kUsage;
+    return 1;
+  }
+  try {
+    auto input = mupm::read_input(*comm, path);
+    mupm::validate_input(*input);
+    if (mode == "validate") {
+      if (root) std::cout << "mupm: " << path << " is valid\n";
+      return 0;
+    }
+    mupm::run_simulation(comm, *input, std::cout);
+  } catch (const mupm::InputError& e) {
+    if (root) std::cerr << "mupm: input error in " << path << ":\n" << e.what() << "\n";
+    return 2;
+  } catch (const mupm::CollectiveError& e) {
+    if (root) std::cerr << "mupm: " << e.what() << "\n";
+    return 3;
+  } catch (const std::exception& e) {
+    // Possibly thrown on this rank alone: stop every rank rather than leave them waiting.
+    std::cerr << "mupm: rank " << comm->getRank() << ": " << e.what() << std::endl;
+    if (comm->getSize() > 1) MPI_Abort(MPI_COMM_WORLD, 3);
+    return 3;
+  }
+  return 0;
+}

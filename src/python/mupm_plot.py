@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""Plot mupm output with matplotlib + h5py (Debian: python3-matplotlib python3-h5py).
+
+  mupm_plot.py field OUTPUT_DIR FIELD [--step N] [--component C] [--scale S] [-o out.png]
+      2D point field (last output step by default) on the deformed points (scale S).
+  mupm_plot.py series OUTPUT_DIR COLUMN [COLUMN...] [-o out.png]
+      columns of time_series.csv against time.
+"""
+import argparse
+import csv
+import glob
+import os
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def plot_field(args):
+    files = sorted(glob.glob(os.path.join(args.dir, "fields_*.h5")))
+    if not files:
+        raise SystemExit("no fields_*.h5 in %s" % args.dir)
+    path = files[-1] if args.step is None else os.path.join(args.dir, "fields_%09d.h5" % args.step)
+    with h5py.File(os.path.join(args.dir, "mesh.h5")) as m, h5py.File(path) as f:
+        x = m["coordinates"][...]
+        if x.shape[1] != 2:
+            raise SystemExit("field plots are for 2D runs; open fields.xmf in ParaView for 3D")
+        if args.field not in f:
+            raise SystemExit("%s not in %s (has: %s)" % (args.field, path, ", ".join(f)))
+        v = f[args.field][...]
+        if v.ndim == 2:
+            v = v[:, args.component]
+        if "displacement" in f and args.scale:
+            x = x + args.scale * f["displacement"][...]
+        time = f.attrs["time"]
+    fig, ax = plt.subplots(figsize=(6, 5))
+    sc = ax.scatter(x[:, 0], x[:, 1], c=v, s=2, marker="s", cmap="viridis")
+    fig.colorbar(sc, ax=ax, label=args.field)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title("%s at t = %.4g s" % (args.field, time))
+    fig.savefig(args.output, dpi=150, bbox_inches="tight")
+    print("wrote", args.output)
+
+
+def plot_series(args):
+    rows = list(csv.DictReader(open(os.path.join(args.dir, "time_series.csv"))))
+    t = np.array([float(r["time"]) for r in rows])
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for c in args.columns:
+        ax.plot(t, [float(r[c]) for r in rows], label=c)
+    ax.set_xlabel("time [s]")
+    ax.legend()
+    fig.savefig(args.output, dpi=150, bbox_inches="tight")
+    print("wrote", args.output)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    sub = p.add_subparsers(dest="cmd", required=True)
+    f = sub.add_parser("field")
+    f.add_argument("dir")
+    f.add_argument("field")
+    f.add_argument("--step", type=int)
+    f.add_argument("--component", type=int, default=0)
+    f.add_argument("--scale", type=float, default=0.0)
+    f.add_argument("-o", "--output", default="field.png")
+    s = sub.add_parser("series")
+    s.add_argument("dir")
+    s.add_argument("columns", nargs="+")
+    s.add_argument("-o", "--output", default="series.png")
+    args = p.parse_args()
+    plot_field(args) if args.cmd == "field" else plot_series(args)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Each class of input error stops both ranks with exit code 2 and a message naming the
+# parameter's full path; none hangs (each run has a time limit) or crashes.
+source "$(dirname "$0")/common.sh"
+
+base() {  # base DISCRETIZATION_EXTRA SOLVER_EXTRA
+  cat <<XML
+<ParameterList name="mupm">
+  <ParameterList name="Discretization">
+    <Parameter name="Spacing" type="double" value="0.01"/>
+    <Parameter name="Counts" type="Array(int)" value="{20, 10}"/>
+    $1
+  </ParameterList>
+  <ParameterList name="Solver">
+    <Parameter name="Number of Steps" type="int" value="2"/>
+    $2
+  </ParameterList>
+  <ParameterList name="Output"><Parameter name="Folder" type="string" value="out"/></ParameterList>
+</ParameterList>
+XML
+}
+
+expect() {  # expect NAME CODE PATTERN... (input in NAME.xml)
+  local name=$1 code=$2
+  shift 2
+  set +e
+  run 2 1 "$name.xml" >"$name.out" 2>&1
+  local got=$?
+  set -e
+  [[ $got == 124 ]] && fail "$name: timed out (hang)"
+  [[ $got == "$code" ]] || { cat "$name.out"; fail "$name: exit code $got, expected $code"; }
+  for p in "$@"; do
+    grep -qF -- "$p" "$name.out" || { cat "$name.out"; fail "$name: message lacks '$p'"; }
+  done
+  echo "ok: $name (exit $got)"
+}
+
+base '<Parameter name="Spacingg" type="double" value="1"/>' '' >unknown.xml
+expect unknown 2 'Spacingg' 'mupm->Discretization' 'valid parameters'
+base '' '<Parameter name="Time Step" type="string" value="fast"/>' >wrong_type.xml
+expect wrong_type 2 'Time Step' 'mupm->Solver' 'double'
+base '' '<Parameter name="Time Step" type="double" value="-1"/>' >out_of_range.xml
+expect out_of_range 2 'Time Step' 'mupm->Solver'
+base '' '' | sed '/Spacing/d' >missing.xml
+expect missing 2 'mupm->Discretization->Spacing' 'missing'
+base '<Parameter name="Origin" type="Array(double)" value="{0, 0, 0}"/>' '' >bad_length.xml
+expect bad_length 2 'mupm->Discretization->Origin' '2 values'
+echo '<ParameterList name="mupm"><Parameter name=' >malformed.xml
+expect malformed 2 'not a valid Teuchos XML'
+set +e
+run 2 1 no_such_file.xml >missing_file.out 2>&1
+got=$?
+set -e
+[[ $got == 2 ]] && grep -qF "cannot read the input file" missing_file.out || fail "missing file: exit $got"
+echo "ok: missing_file (exit $got)"
+# A valid input validates, and --print-defaults is XML that documents every parameter.
+base '' '' >valid.xml
+run 2 1 --validate valid.xml | grep -q "is valid" || fail "--validate of a valid input"
+"$MUPM" --print-defaults >defaults.xml
+"$PYTHON" - defaults.xml <<'PY'
+import sys, xml.etree.ElementTree as ET
+root = ET.parse(sys.argv[1]).getroot()
+params = root.iter("Parameter")
+n = 0
+for p in params:
+    n += 1
+    assert p.get("docString"), "parameter %s has no doc string" % p.get("name")
+assert n > 20, n
+print("defaults: %d parameters, all documented" % n)
+PY
+echo "cli_errors: all passed"

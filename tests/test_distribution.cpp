@@ -1,0 +1,128 @@
+// Distribution: the partition covers every point once, ghost values equal their owners', and
+// the bond list by global ids does not depend on the number of ranks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "test_utils.hpp"
+
+namespace mupm {
+namespace {
+
+double field_value(GlobalId g, int c) { return std::sin(0.37 * double(g) + 1.3 * c) * 1e3 + g; }
+
+template <int Dim>
+void check_ghosts(const GridSpec<Dim>& g) {
+  auto disc = discretize(test::world(), g);
+  auto& pts = disc.points;
+  // Owned values from the global id; ghosts poisoned; the refresh must bring the owners' values.
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.gid);
+  auto u = Kokkos::create_mirror_view(pts.u);
+  auto p = Kokkos::create_mirror_view(pts.p);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const bool owned = i < pts.n_owned;
+    for (int d = 0; d < Dim; ++d) u(i, d) = owned ? field_value(gid(i), d) : NAN;
+    p(i) = owned ? -field_value(gid(i), 7) : NAN;
+  }
+  Kokkos::deep_copy(pts.u, u);
+  Kokkos::deep_copy(pts.p, p);
+  disc.dist.refresh({pts.u, as_vectors(pts.p)});
+  Kokkos::deep_copy(u, pts.u);
+  Kokkos::deep_copy(p, pts.p);
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
+  for (std::size_t i = pts.n_owned; i < pts.size(); ++i) {
+    for (int d = 0; d < Dim; ++d) ASSERT_EQ(u(i, d), field_value(gid(i), d)) << "ghost " << gid(i);
+    ASSERT_EQ(p(i), -field_value(gid(i), 7));
+    // Constants travelled once at set-up: the ghost's position is its owner's.
+    const auto xg = test::position(g, gid(i));
+    for (int d = 0; d < Dim; ++d) ASSERT_EQ(x(i, d), xg[d]);
+  }
+  // Every neighbour of an owned point is present locally (owned or ghost).
+  EXPECT_EQ(disc.dist.refresh_count(), 2u);
+  long long n = static_cast<long long>(pts.n_owned), total = 0;
+  MPI_Allreduce(&n, &total, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(total, g.n_global());
+}
+
+TEST(Distribution, GhostsEqualOwners2D) {
+  auto g = test::box<2>({20, 9}, 3.015);
+  g.layers[1] = {3, 3};
+  check_ghosts(g);
+}
+
+TEST(Distribution, GhostsEqualOwners3D) { check_ghosts(test::box<3>({8, 7, 9}, 3.015)); }
+
+// (gid_i, gid_j, intact) of every bond, gathered on rank 0 in gid order.
+template <int Dim>
+std::vector<long long> global_bond_list(const Teuchos::RCP<const Comm>& comm,
+                                        const GridSpec<Dim>& g) {
+  auto disc = discretize(comm, g);
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.gid);
+  auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.offsets);
+  auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.neighbor);
+  auto in = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.intact);
+  std::vector<long long> mine;
+  for (std::size_t i = 0; i < disc.points.n_owned; ++i)
+    for (BondIndex b = off(i); b < off(i + 1); ++b) {
+      mine.push_back(gid(i));
+      mine.push_back(gid(nb(b)));
+      mine.push_back(in(b));
+    }
+  int size = comm->getSize(), rank = comm->getRank();
+  if (size == 1) return mine;
+  int count = int(mine.size());
+  std::vector<int> counts(size), displs(size, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<long long> all(rank == 0 ? displs[size - 1] + counts[size - 1] : 0);
+  MPI_Gatherv(mine.data(), count, MPI_LONG_LONG, all.data(), counts.data(), displs.data(),
+              MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  // Rows of the triples sorted by (gid_i, position in row): a stable sort on gid_i keeps each
+  // row's own order.
+  std::vector<std::array<long long, 3>> rows(all.size() / 3);
+  for (std::size_t k = 0; k < rows.size(); ++k) rows[k] = {all[3 * k], all[3 * k + 1], all[3 * k + 2]};
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const auto& a, const auto& b) { return a[0] < b[0]; });
+  std::vector<long long> out;
+  for (const auto& r : rows) out.insert(out.end(), r.begin(), r.end());
+  return out;
+}
+
+template <int Dim>
+void check_rank_independence(const GridSpec<Dim>& g) {
+  const auto distributed = global_bond_list(test::world(), g);
+  if (test::world()->getRank() == 0) {
+    const auto serial = global_bond_list(test::self(), g);
+    EXPECT_EQ(distributed, serial);
+    EXPECT_GT(serial.size(), 0u);
+  }
+}
+
+TEST(Distribution, BondListIndependentOfRanks) {
+  auto g2 = test::box<2>({17, 12}, 3.015);
+  Crack c;
+  c.a[0] = 0.02;
+  c.a[1] = 0.06;
+  c.b[0] = 0.2;
+  c.b[1] = 0.06;
+  g2.cracks = {c};
+  g2.layers[0] = {3, 3};
+  check_rank_independence(g2);
+  check_rank_independence(test::box<3>({6, 7, 5}, 4.015));
+}
+
+TEST(Distribution, PartitionCoversLattice) {
+  for (int n_ranks : {1, 2, 3, 5, 8}) {
+    auto g = test::box<3>({9, 4, 7}, 3.015);
+    std::vector<int> owner(std::size_t(g.n_global()), -1);
+    for (int r = 0; r < n_ranks; ++r)
+      for (GlobalId k : box_gids(g, partition_lattice(g, n_ranks, r))) {
+        ASSERT_EQ(owner[std::size_t(k)], -1) << "gid " << k << " owned twice";
+        owner[std::size_t(k)] = r;
+      }
+    for (int o : owner) ASSERT_GE(o, 0);
+  }
+}
+
+}  // namespace
+}  // namespace mupm

@@ -1,0 +1,49 @@
+// Helpers shared by the tests: communicators and small grids.
+#ifndef MUPM_TEST_UTILS_HPP
+#define MUPM_TEST_UTILS_HPP
+
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <Tpetra_Core.hpp>
+#include <cstdlib>
+#include <string>
+
+#include "mupm/discretization.hpp"
+
+namespace mupm::test {
+
+inline Teuchos::RCP<const Comm> world() { return Tpetra::getDefaultComm(); }
+inline Teuchos::RCP<const Comm> self() {
+  return Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+}
+
+// A box of counts points of spacing dx, horizon factor*dx, origin 0.
+template <int Dim>
+GridSpec<Dim> box(std::array<long long, Dim> counts, double factor, double dx = 0.01) {
+  GridSpec<Dim> g;
+  g.counts = counts;
+  g.dx = dx;
+  g.horizon = factor * dx;
+  return g;
+}
+
+// Lattice position of a global id (the tests' own version of the grid's numbering).
+template <int Dim>
+std::array<double, Dim> position(const GridSpec<Dim>& g, GlobalId gid) {
+  std::array<double, Dim> x{};
+  for (int d = 0; d < Dim; ++d) {
+    const long long n = g.lattice_count(d);
+    const long long k = gid % n - g.layers[d][0];
+    gid /= n;
+    x[d] = g.origin[d] + (double(k) + 0.5) * g.dx;
+  }
+  return x;
+}
+
+inline std::string tmp_dir() {
+  const char* d = std::getenv("MUPM_TEST_TMPDIR");
+  return d ? d : "/tmp";
+}
+
+}  // namespace mupm::test
+
+#endif
