@@ -14,7 +14,9 @@ namespace {
 
 using namespace mupm;
 
-Teuchos::RCP<const Comm> self() { return Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF)); }
+Teuchos::RCP<const Comm> self() {
+  return Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+}
 
 template <int Dim>
 GridSpec<Dim> grid(long long n_per_axis, double factor) {
@@ -65,17 +67,30 @@ void BM_ShapeTensorBondLoop(benchmark::State& state) {
       benchmark::Counter(n_points, benchmark::Counter::kIsIterationInvariantRate);
 }
 
-BENCHMARK_TEMPLATE(BM_NeighborBuild, 2)->Args({400, 3015})->Args({400, 4015})->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_NeighborBuild, 3)->Args({50, 3015})->Args({50, 4015})->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_ShapeTensorBondLoop, 2)->Args({400, 3015})->Args({400, 4015})->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_ShapeTensorBondLoop, 3)->Args({50, 3015})->Args({50, 4015})->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_NeighborBuild, 2)
+    ->Args({400, 3015})
+    ->Args({400, 4015})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_NeighborBuild, 3)
+    ->Args({50, 3015})
+    ->Args({50, 4015})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_ShapeTensorBondLoop, 2)
+    ->Args({400, 3015})
+    ->Args({400, 4015})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_ShapeTensorBondLoop, 3)
+    ->Args({50, 3015})
+    ->Args({50, 4015})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
 int main(int argc, char** argv) {
   Tpetra::ScopeGuard scope(&argc, &argv);
   benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  if (benchmark::ReportUnrecognizedArguments(argc, argv))
+    return 1;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -5,8 +5,8 @@
 
 namespace mupm {
 
-Distribution::Distribution(const Teuchos::RCP<const Comm>& comm,
-                           const std::vector<GlobalId>& owned, const std::vector<GlobalId>& ghosts)
+Distribution::Distribution(const Teuchos::RCP<const Comm>& comm, const std::vector<GlobalId>& owned,
+                           const std::vector<GlobalId>& ghosts)
     : comm_(comm), n_owned_(owned.size()), n_ghost_(ghosts.size()) {
   const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
   owned_map_ = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GlobalId>(owned), 0, comm));
@@ -19,8 +19,10 @@ Distribution::Distribution(const Teuchos::RCP<const Comm>& comm,
 void Distribution::refresh(const std::vector<Vectors>& fields) {
   ScopedRegion region("mupm::Comm::ghost_refresh");
   std::size_t width = 0;
-  for (const auto& f : fields) width += f.extent(1);
-  if (width == 0) return;
+  for (const auto& f : fields)
+    width += f.extent(1);
+  if (width == 0)
+    return;
   if (owned_buf_.is_null() || owned_buf_->getNumVectors() != width) {
     owned_buf_ = Teuchos::rcp(new MultiVector(owned_map_, width, false));
     overlap_buf_ = Teuchos::rcp(new MultiVector(overlap_map_, width, false));
@@ -33,7 +35,8 @@ void Distribution::refresh(const std::vector<Vectors>& fields) {
       const std::size_t nc = f.extent(1), c0 = col;
       Kokkos::parallel_for(
           "mupm::Comm::pack", range(0, n_own), KOKKOS_LAMBDA(const std::size_t i) {
-            for (std::size_t c = 0; c < nc; ++c) buf(i, c0 + c) = f(i, c);
+            for (std::size_t c = 0; c < nc; ++c)
+              buf(i, c0 + c) = f(i, c);
           });
       col += nc;
     }
@@ -46,7 +49,8 @@ void Distribution::refresh(const std::vector<Vectors>& fields) {
       const std::size_t nc = f.extent(1), c0 = col;
       Kokkos::parallel_for(
           "mupm::Comm::unpack", range(n_own, n_own + n_gh), KOKKOS_LAMBDA(const std::size_t i) {
-            for (std::size_t c = 0; c < nc; ++c) f(i, c) = buf(i, c0 + c);
+            for (std::size_t c = 0; c < nc; ++c)
+              f(i, c) = buf(i, c0 + c);
           });
       col += nc;
     }

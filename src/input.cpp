@@ -3,8 +3,12 @@
 #include <Teuchos_Array.hpp>
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <Teuchos_StringInputSource.hpp>
+#include <Teuchos_XMLObject.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -18,9 +22,9 @@ using Teuchos::ParameterList;
 using Teuchos::RCP;
 using Teuchos::rcp;
 
-const std::vector<std::string> kIcFields = {"Displacement",   "Velocity",        "Micro-Rotation",
-                                            "Micro-Rotation Rate", "Pore Pressure",
-                                            "Fracture Pressure", "Porosity",    "Saturation"};
+const std::vector<std::string> kIcFields = {
+    "Displacement",  "Velocity",          "Micro-Rotation", "Micro-Rotation Rate",
+    "Pore Pressure", "Fracture Pressure", "Porosity",       "Saturation"};
 const std::vector<std::string> kFaces = {"-x", "+x", "-y", "+y", "-z", "+z"};
 
 template <class T>
@@ -66,11 +70,22 @@ const std::vector<std::pair<std::string, void (*)(ParameterList&)>> kNamedSublis
 }  // namespace
 
 const std::vector<std::string>& output_field_names() {
-  static const std::vector<std::string> names = {
-      "displacement", "velocity",  "acceleration",   "micro_rotation", "micro_rotation_rate",
-      "pore_pressure", "fracture_pressure", "porosity", "saturation",   "damage",
-      "fracture",      "flags",     "regions",        "stress",         "couple_stress",
-      "plastic_strain"};
+  static const std::vector<std::string> names = {"displacement",
+                                                 "velocity",
+                                                 "acceleration",
+                                                 "micro_rotation",
+                                                 "micro_rotation_rate",
+                                                 "pore_pressure",
+                                                 "fracture_pressure",
+                                                 "porosity",
+                                                 "saturation",
+                                                 "damage",
+                                                 "fracture",
+                                                 "flags",
+                                                 "regions",
+                                                 "stress",
+                                                 "couple_stress",
+                                                 "plastic_strain"};
   return names;
 }
 
@@ -112,7 +127,8 @@ RCP<ParameterList> valid_parameters() {
                                  "fracture points.");
     crack_template(c.sublist("NAME"));
   }
-  pl->sublist("Materials", false, "Solid constitutive models (filled by the solid-mechanics issue).");
+  pl->sublist("Materials", false,
+              "Solid constitutive models (filled by the solid-mechanics issue).");
   pl->sublist("Fluid", false, "Pore fluid properties (filled by the pore-fluid issue).");
   pl->sublist("Fracture", false, "Bond breakage and fracture flow (filled by the fracture issue).");
   pl->sublist("Boundary Conditions", false,
@@ -149,8 +165,7 @@ RCP<ParameterList> valid_parameters() {
           "porosity, saturation, damage, fracture, flags, regions, stress, couple_stress, "
           "plastic_strain. Global id and reference position are always written.",
           rcp(new Teuchos::ArrayStringValidator(one_of(output_field_names()))));
-    o.set("Time Series Interval", 1, "Steps between rows of time_series.csv (>= 1).",
-          at_least(1));
+    o.set("Time Series Interval", 1, "Steps between rows of time_series.csv (>= 1).", at_least(1));
     o.set("Checkpoint Interval", 0, "Steps between checkpoints; 0: none during the run.",
           at_least(0));
     o.set("Checkpoint At End", true, "Write a checkpoint after the last step.");
@@ -179,10 +194,13 @@ std::string path_of(const ParameterList& list, const std::string& name) {
 std::string clean_teuchos(const std::exception& e) {
   std::string msg = e.what();
   const auto pos = msg.find("Error");
-  if (pos != std::string::npos && pos > 0) msg = msg.substr(pos);
+  if (pos != std::string::npos && pos > 0)
+    msg = msg.substr(pos);
   const auto tr = msg.find("Throw number");
-  if (tr != std::string::npos) msg = msg.substr(0, tr);
-  while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' ')) msg.pop_back();
+  if (tr != std::string::npos)
+    msg = msg.substr(0, tr);
+  while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' '))
+    msg.pop_back();
   return msg;
 }
 
@@ -190,7 +208,8 @@ std::string clean_teuchos(const std::exception& e) {
 void name_lists(ParameterList& list, const std::string& path) {
   list.setName(path);
   for (auto it = list.begin(); it != list.end(); ++it)
-    if (list.entry(it).isList()) name_lists(list.sublist(list.name(it)), path + "->" + list.name(it));
+    if (list.entry(it).isList())
+      name_lists(list.sublist(list.name(it)), path + "->" + list.name(it));
 }
 
 void validate_level(ParameterList& list, const ParameterList& valid) {
@@ -229,20 +248,21 @@ void validate_level(ParameterList& list, const ParameterList& valid) {
   // Validators' own messages do not say where the entry is: add its full path.
   for (auto it = list.begin(); it != list.end(); ++it) {
     const auto* ventry = valid.getEntryPtr(list.name(it));
-    if (!ventry || ventry->isList() || list.entry(it).isList()) continue;
+    if (!ventry || ventry->isList() || list.entry(it).isList())
+      continue;
     const auto& any = list.entry(it).getAny(false);
     if (any.type() != ventry->getAny(false).type())
-      throw InputError("Error, " + path_of(list, list.name(it)) + " has type \"" +
-                       any.typeName() + "\" (value \"" + Teuchos::toString(any) +
-                       "\"); the expected type is \"" + ventry->getAny(false).typeName() +
-                       "\": " + ventry->docString());
-    if (ventry->validator().is_null()) continue;
+      throw InputError("Error, " + path_of(list, list.name(it)) + " has type \"" + any.typeName() +
+                       "\" (value \"" + Teuchos::toString(any) + "\"); the expected type is \"" +
+                       ventry->getAny(false).typeName() + "\": " + ventry->docString());
+    if (ventry->validator().is_null())
+      continue;
     try {
       ventry->validator()->validate(list.entry(it), list.name(it), list.name());
     } catch (const std::exception& e) {
       throw InputError("Error, " + path_of(list, list.name(it)) + " = " +
                        Teuchos::toString(list.entry(it).getAny(false)) +
-                       " is not valid: " + clean_teuchos(e));
+                       " is not valid. Expected: " + ventry->docString() + "\n" + clean_teuchos(e));
     }
   }
   try {
@@ -265,7 +285,8 @@ void validate_level(ParameterList& list, const ParameterList& valid) {
     }
     ParameterList& sub = list.sublist(name);
     const ParameterList& vsub = Teuchos::getValue<ParameterList>(valid.entry(it));
-    if (vsub.isSublist("NAME")) continue;  // children checked above
+    if (vsub.isSublist("NAME"))
+      continue;  // children checked above
     validate_level(sub, vsub);
   }
 }
@@ -291,8 +312,10 @@ void check_dimension_arrays(ParameterList& input) {
   if (has_counts == has_extents)
     throw InputError("Error, " + d.name() +
                      " needs exactly one of Counts (points per axis) and Extents (body size "
-                     "in m), each with " + std::to_string(dim) + " values.");
-  if (has_counts) get_array<int>(d, "Counts", dim, "points per axis");
+                     "in m), each with " +
+                     std::to_string(dim) + " values.");
+  if (has_counts)
+    get_array<int>(d, "Counts", dim, "points per axis");
   if (has_extents) {
     const auto ext = get_array<double>(d, "Extents", dim, "body size per axis in m");
     const double dx = d.get<double>("Spacing");
@@ -300,11 +323,12 @@ void check_dimension_arrays(ParameterList& input) {
       const double n = e / dx;
       if (!(n >= 1) || std::abs(n - std::round(n)) > 1e-6 * n)
         throw InputError("Error, " + path_of(d, "Extents") + " = " + std::to_string(e) +
-                         " is not a positive whole multiple of Spacing = " +
-                         std::to_string(dx) + ".");
+                         " is not a positive whole multiple of Spacing = " + std::to_string(dx) +
+                         ".");
     }
   }
-  if (!d.get<Array<double>>("Origin").empty()) get_array<double>(d, "Origin", dim, "m");
+  if (!d.get<Array<double>>("Origin").empty())
+    get_array<double>(d, "Origin", dim, "m");
   if (d.get<double>("Horizon") > 0 && d.isParameter("Horizon Factor") &&
       !d.getEntry("Horizon Factor").isDefault())
     throw InputError("Error, " + d.name() +
@@ -363,7 +387,8 @@ void check_dimension_arrays(ParameterList& input) {
     get_array<double>(c, "Value", n, field);
     const std::string region = c.get<std::string>("Region");
     bool known = region == "All" || regions.isSublist(region);
-    for (const auto& f : faces) known = known || region == "Layer " + f;
+    for (const auto& f : faces)
+      known = known || region == "Layer " + f;
     if (!known)
       throw InputError("Error, " + path_of(c, "Region") + " = '" + region +
                        "' names no region; expected All, a sublist of " + regions.name() +
@@ -371,16 +396,87 @@ void check_dimension_arrays(ParameterList& input) {
   }
 }
 
+// Teuchos reads numbers with operator>>, which turns "abc" or "1e-3x" in an Array(double) into
+// 0 without a word. Check every numeric value's text strictly before Teuchos converts it.
+bool strict_number(const std::string& token, bool integer) {
+  std::size_t b = token.find_first_not_of(" \t\n"), e = token.find_last_not_of(" \t\n");
+  if (b == std::string::npos)
+    return false;
+  const std::string t = token.substr(b, e - b + 1);
+  char* end = nullptr;
+  errno = 0;
+  if (integer) {
+    const long long v = std::strtoll(t.c_str(), &end, 10);
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+      return false;
+  } else {
+    const double v = std::strtod(t.c_str(), &end);
+    if (!std::isfinite(v))
+      return false;
+  }
+  return errno == 0 && end == t.c_str() + t.size();
+}
+
+void check_numbers(const Teuchos::XMLObject& node, const std::string& path) {
+  for (int k = 0; k < node.numChildren(); ++k) {
+    const Teuchos::XMLObject& c = node.getChild(k);
+    if (!c.hasAttribute("name"))
+      continue;
+    const std::string name = c.getAttribute("name");
+    if (c.getTag() == "ParameterList") {
+      check_numbers(c, path + "->" + name);
+      continue;
+    }
+    if (c.getTag() != "Parameter" || !c.hasAttribute("type") || !c.hasAttribute("value"))
+      continue;
+    const std::string type = c.getAttribute("type"), value = c.getAttribute("value");
+    const bool is_int = type == "int" || type == "Array(int)";
+    const bool is_double = type == "double" || type == "Array(double)";
+    if (!is_int && !is_double)
+      continue;
+    std::vector<std::string> tokens;
+    if (type.rfind("Array", 0) == 0) {
+      std::size_t b = value.find('{'), e = value.rfind('}');
+      if (b == std::string::npos || e == std::string::npos || e < b)
+        throw InputError("Error, " + path + "->" + name + " = \"" + value +
+                         "\" is not an array: write {a, b, ...}.");
+      const std::string inner = value.substr(b + 1, e - b - 1);
+      if (inner.find_first_not_of(" \t\n") != std::string::npos) {
+        std::stringstream ss(inner);
+        for (std::string tok; std::getline(ss, tok, ',');)
+          tokens.push_back(tok);
+      }
+    } else {
+      tokens.push_back(value);
+    }
+    for (const auto& tok : tokens)
+      if (!strict_number(tok, is_int))
+        throw InputError("Error, " + path + "->" + name + " = \"" + value + "\": \"" + tok +
+                         "\" is not a finite " + (is_int ? "int" : "double") + " number.");
+  }
+}
+
 }  // namespace
 
 RCP<ParameterList> parse_input(const std::string& xml) {
+  try {
+    check_numbers(Teuchos::StringInputSource(xml).getObject(), "mupm");
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception&) {
+    // Malformed XML: reported below by the parameter-list reader with its line number.
+  }
   try {
     auto pl = Teuchos::getParametersFromXmlString(xml);
     name_lists(*pl, "mupm");
     return pl;
   } catch (const std::exception& e) {
-    throw InputError(std::string("Error, the input is not a valid Teuchos XML parameter list: ") +
-                     e.what());
+    // Keep the parser's own sentence ("XML parse error at line N: ..."), not its source location.
+    std::string msg = e.what();
+    const auto pos = msg.find("XML parse error");
+    if (pos != std::string::npos)
+      msg = msg.substr(pos);
+    throw InputError("Error, the input is not a valid Teuchos XML parameter list: " + msg);
   }
 }
 
@@ -398,17 +494,18 @@ RCP<ParameterList> read_input(const Teuchos::Comm<int>& comm, const std::string&
     }
   }
   Teuchos::broadcast(comm, 0, &ok);
-  if (!ok) throw InputError("Error, cannot read the input file '" + path + "'.");
+  if (!ok)
+    throw InputError("Error, cannot read the input file '" + path + "'.");
   long long n = static_cast<long long>(text.size());
   Teuchos::broadcast(comm, 0, &n);
   text.resize(static_cast<std::size_t>(n));
-  if (n > 0) Teuchos::broadcast(comm, 0, static_cast<int>(n), &text[0]);
+  if (n > 0)
+    Teuchos::broadcast(comm, 0, static_cast<int>(n), &text[0]);
   return parse_input(text);
 }
 
 void validate_input(ParameterList& input) {
-  if (input.isSublist("Discretization") &&
-      !input.sublist("Discretization").isParameter("Spacing"))
+  if (input.isSublist("Discretization") && !input.sublist("Discretization").isParameter("Spacing"))
     throw InputError("Error, the required parameter " + input.name() +
                      "->Discretization->Spacing (point spacing in m, a double > 0) is missing.");
   if (!input.isSublist("Discretization"))
@@ -455,15 +552,18 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
   // Boundary layers as regions: the rows outside the face, across the whole lattice.
   for (int k = 0; k < Dim; ++k)
     for (int side = 0; side < 2; ++side) {
-      if (g.layers[k][side] == 0) continue;
+      if (g.layers[k][side] == 0)
+        continue;
       Box b;
       for (int j = 0; j < Dim; ++j) {
         b.lo[j] = g.origin[j] - (g.layers[j][0] + 1) * g.dx;
         b.hi[j] = g.origin[j] + (g.counts[j] + g.layers[j][1] + 1) * g.dx;
       }
       const double lo_face = g.origin[k], hi_face = g.origin[k] + g.counts[k] * g.dx;
-      if (side == 0) b.hi[k] = lo_face - 0.25 * g.dx;
-      else b.lo[k] = hi_face + 0.25 * g.dx;
+      if (side == 0)
+        b.hi[k] = lo_face - 0.25 * g.dx;
+      else
+        b.lo[k] = hi_face + 0.25 * g.dx;
       g.region_names.push_back(std::string("Layer ") + (side ? '+' : '-') + char('x' + k));
       g.regions.push_back(b);
     }
@@ -498,7 +598,8 @@ std::vector<InitialCondition> initial_conditions_from_input(const ParameterList&
   const ParameterList& d = input.sublist("Discretization");
   std::vector<std::string> names;
   const ParameterList& regions = d.sublist("Regions");
-  for (auto it = regions.begin(); it != regions.end(); ++it) names.push_back(regions.name(it));
+  for (auto it = regions.begin(); it != regions.end(); ++it)
+    names.push_back(regions.name(it));
   const int dim = d.get<int>("Dimension");
   // Same order as grid_from_input appends the layer regions.
   const auto faces = d.get<Array<std::string>>("Boundary Layers");
@@ -520,7 +621,8 @@ std::vector<InitialCondition> initial_conditions_from_input(const ParameterList&
     ic.field = c.get<std::string>("Field");
     const std::string region = c.get<std::string>("Region");
     for (std::size_t r = 0; r < names.size(); ++r)
-      if (names[r] == region) ic.region_mask = 1u << r;
+      if (names[r] == region)
+        ic.region_mask = 1u << r;
     const auto v = c.get<Array<double>>("Value");
     ic.value.assign(v.begin(), v.end());
     out.push_back(ic);

@@ -35,45 +35,54 @@ int main(int argc, char* argv[]) {
     } else if (a == "--validate") {
       mode = "validate";
     } else if (!a.empty() && a[0] == '-') {
-      if (root) std::cerr << "mupm: unknown option " << a << "\n" << kUsage;
+      if (root)
+        std::cerr << "mupm: unknown option " << a << "\n" << kUsage;
       return 1;
     } else if (path.empty()) {
       path = a;
     } else {
-      if (root) std::cerr << "mupm: more than one input file given\n" << kUsage;
+      if (root)
+        std::cerr << "mupm: more than one input file given\n" << kUsage;
       return 1;
     }
   }
   if (mode == "help") {
-    if (root) std::cout << kUsage;
+    if (root)
+      std::cout << kUsage;
     return 0;
   }
   if (mode == "defaults") {
-    if (root) Teuchos::writeParameterListToXmlOStream(*mupm::valid_parameters(), std::cout);
+    if (root)
+      Teuchos::writeParameterListToXmlOStream(*mupm::valid_parameters(), std::cout);
     return 0;
   }
   if (path.empty()) {
-    if (root) std::cerr << "mupm: no input file given\n" << kUsage;
+    if (root)
+      std::cerr << "mupm: no input file given\n" << kUsage;
     return 1;
   }
   try {
     auto input = mupm::read_input(*comm, path);
     mupm::validate_input(*input);
     if (mode == "validate") {
-      if (root) std::cout << "mupm: " << path << " is valid\n";
+      if (root)
+        std::cout << "mupm: " << path << " is valid\n";
       return 0;
     }
     mupm::run_simulation(comm, *input, std::cout);
   } catch (const mupm::InputError& e) {
-    if (root) std::cerr << "mupm: input error in " << path << ":\n" << e.what() << "\n";
+    if (root)
+      std::cerr << "mupm: input error in " << path << ":\n" << e.what() << "\n";
     return 2;
   } catch (const mupm::CollectiveError& e) {
-    if (root) std::cerr << "mupm: " << e.what() << "\n";
+    if (root)
+      std::cerr << "mupm: " << e.what() << "\n";
     return 3;
   } catch (const std::exception& e) {
     // Possibly thrown on this rank alone: stop every rank rather than leave them waiting.
     std::cerr << "mupm: rank " << comm->getRank() << ": " << e.what() << std::endl;
-    if (comm->getSize() > 1) MPI_Abort(MPI_COMM_WORLD, 3);
+    if (comm->getSize() > 1)
+      MPI_Abort(MPI_COMM_WORLD, 3);
     return 3;
   }
   return 0;

@@ -43,7 +43,8 @@ template <class T>
 std::vector<double> owned_as_double(const View1<T>& f, std::size_t n_owned) {
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), f);
   std::vector<double> out(n_owned);
-  for (std::size_t i = 0; i < n_owned; ++i) out[i] = double(h(i));
+  for (std::size_t i = 0; i < n_owned; ++i)
+    out[i] = double(h(i));
   return out;
 }
 
@@ -90,14 +91,17 @@ void apply_initial_conditions(const std::vector<InitialCondition>& ics, Points<D
         target = f.view;
     }
     Kokkos::Array<double, 3> value{};
-    for (std::size_t c = 0; c < ic.value.size() && c < 3; ++c) value[c] = ic.value[c];
+    for (std::size_t c = 0; c < ic.value.size() && c < 3; ++c)
+      value[c] = ic.value[c];
     const std::uint32_t mask = ic.region_mask;
     auto regions = p.regions;
     const std::size_t nc = target.extent(1);
     Kokkos::parallel_for(
         "mupm::Setup::initial_condition", range(0, p.size()), KOKKOS_LAMBDA(const std::size_t i) {
-          if (mask != 0 && (regions(i) & mask) == 0) return;
-          for (std::size_t c = 0; c < nc; ++c) target(i, c) = value[c];
+          if (mask != 0 && (regions(i) & mask) == 0)
+            return;
+          for (std::size_t c = 0; c < nc; ++c)
+            target(i, c) = value[c];
         });
   }
   Kokkos::fence();
@@ -143,7 +147,8 @@ BondTable<Dim> bond_table(const Discretization<Dim>& disc, MPI_Comm comm) {
   const auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.gid);
   const std::size_t n = disc.points.n_owned;
   long long w = 0;
-  for (std::size_t i = 0; i < n; ++i) w = std::max<long long>(w, off(i + 1) - off(i));
+  for (std::size_t i = 0; i < n; ++i)
+    w = std::max<long long>(w, off(i + 1) - off(i));
   MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_LONG_LONG, MPI_MAX, comm);
   BondTable<Dim> t;
   t.width = int(std::max<long long>(w, 1));
@@ -199,7 +204,8 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
   MPI_Barrier(comm);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
-  if (rank == 0) std::filesystem::rename(tmp, path);
+  if (rank == 0)
+    std::filesystem::rename(tmp, path);
   MPI_Barrier(comm);
 }
 
@@ -214,7 +220,7 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
   auto mismatch = [&](const std::string& what, const std::string& found,
                       const std::string& expected) {
     throw CollectiveError("Error, the checkpoint '" + path + "' does not match this input: " +
-                             what + " is " + found + " there and " + expected + " here.");
+                          what + " is " + found + " there and " + expected + " here.");
   };
   if (file.read_attribute_int("dimension") != Dim)
     mismatch("the dimension", std::to_string(file.read_attribute_int("dimension")),
@@ -250,8 +256,8 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
   MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPI_INT, MPI_MIN, comm);
   if (!same)
     throw CollectiveError("Error, the checkpoint '" + path +
-                             "' holds other bonds than this input makes (horizon, pre-cracks or "
-                             "grid differ).");
+                          "' holds other bonds than this input makes (horizon, pre-cracks or "
+                          "grid differ).");
   file.read_points("bonds/intact", gids, t.width, t.intact.data());
   file.read_points("bonds/energy", gids, t.width, t.energy.data());
   auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.offsets);
@@ -319,23 +325,29 @@ class FieldOutput {
     history_.push_back(time);
     int rank = 0;
     MPI_Comm_rank(comm, &rank);
-    if (rank == 0) write_index();
+    if (rank == 0)
+      write_index();
   }
 
  private:
   std::pair<int, std::vector<double>> field_rows(const std::string& f, std::size_t n) const {
     const auto& p = disc_.points;
-    if (f == "fracture") return {1, owned_as_double(p.fracture, n)};
-    if (f == "flags") return {1, owned_as_double(p.flags, n)};
-    if (f == "regions") return {1, owned_as_double(p.regions, n)};
+    if (f == "fracture")
+      return {1, owned_as_double(p.fracture, n)};
+    if (f == "flags")
+      return {1, owned_as_double(p.flags, n)};
+    if (f == "regions")
+      return {1, owned_as_double(p.regions, n)};
     for (const auto& s : state_fields(p))
-      if (s.name == f) return {int(s.view.extent(1)), owned_rows(s.view, n)};
+      if (s.name == f)
+        return {int(s.view.extent(1)), owned_rows(s.view, n)};
     throw std::logic_error("unknown output field " + f);
   }
 
   int ncomp_of(const std::string& f) const {
     for (const auto& s : state_fields(disc_.points))
-      if (s.name == f) return int(s.view.extent(1));
+      if (s.name == f)
+        return int(s.view.extent(1));
     return 1;
   }
 
@@ -346,7 +358,8 @@ class FieldOutput {
       std::snprintf(name, sizeof name, "fields_%09lld.h5", static_cast<long long>(history_[k]));
       io::XdmfStep s;
       s.time = history_[k + 1];
-      for (const auto& f : fields_) s.fields.push_back({f, ncomp_of(f), name, "/" + f});
+      for (const auto& f : fields_)
+        s.fields.push_back({f, ncomp_of(f), name, "/" + f});
       steps.push_back(s);
     }
     io::write_xdmf(folder_ + "/fields.xmf", Dim, disc_.dist.n_global(), "mesh.h5", "/coordinates",
@@ -359,25 +372,27 @@ class FieldOutput {
   std::vector<double> history_;  // (step, time) pairs of the outputs written so far
 };
 
-// The largest global id of an owned point holding a NaN or Inf in its state, or -1.
+// The largest global id of an owned point whose primary state (u, v, a, theta and its rates,
+// p, p_f) holds a NaN or Inf, or -1. Every other field derives from these. One pass.
 template <int Dim>
 GlobalId non_finite_point(const Points<Dim>& p) {
-  GlobalId found = -1;
-  for (const auto& f : state_fields(p)) {
-    auto v = f.view;
-    auto gid = p.gid;
-    const std::size_t nc = v.extent(1);
-    GlobalId g = -1;
-    Kokkos::parallel_reduce(
-        "mupm::Diagnostics::finite", range(0, p.n_owned),
-        KOKKOS_LAMBDA(const std::size_t i, GlobalId& m) {
-          for (std::size_t c = 0; c < nc; ++c)
-            if (!std::isfinite(v(i, c)) && gid(i) > m) m = gid(i);
-        },
-        Kokkos::Max<GlobalId>(g));
-    found = g > found ? g : found;
-  }
-  return found;
+  auto u = p.u, v = p.v, a = p.a, th = p.theta, om = p.omega, al = p.alpha;
+  auto pw = p.p, pf = p.pf;
+  auto gid = p.gid;
+  GlobalId g = -1;
+  Kokkos::parallel_reduce(
+      "mupm::Diagnostics::finite", range(0, p.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i, GlobalId& m) {
+        bool ok = std::isfinite(pw(i)) && std::isfinite(pf(i));
+        for (int k = 0; k < Dim; ++k)
+          ok = ok && std::isfinite(u(i, k)) && std::isfinite(v(i, k)) && std::isfinite(a(i, k));
+        for (int k = 0; k < kRotDim<Dim>; ++k)
+          ok = ok && std::isfinite(th(i, k)) && std::isfinite(om(i, k)) && std::isfinite(al(i, k));
+        if (!ok && gid(i) > m)
+          m = gid(i);
+      },
+      Kokkos::Max<GlobalId>(g));
+  return g;
 }
 
 template <int Dim>
@@ -414,7 +429,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   Teuchos::broadcast(*comm, 0, &ok);
   if (!ok)
     throw CollectiveError("Error, cannot write to the output folder '" + folder +
-                             "' (Output->Folder)" + (why.empty() ? "" : ": " + why));
+                          "' (Output->Folder)" + (why.empty() ? "" : ": " + why));
 
   const GridSpec<Dim> grid = grid_from_input<Dim>(input);
   Discretization<Dim> disc = discretize(comm, grid);
@@ -440,12 +455,13 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   const std::string restart = solver.get<std::string>("Restart From");
   if (!restart.empty()) {
     read_checkpoint(restart, disc, step, time, history);
-    if (rank == 0) out << "mupm: restarted from " << restart << " at step " << step << "\n";
+    if (rank == 0)
+      out << "mupm: restarted from " << restart << " at step " << step << "\n";
   }
   compute_damage(disc.bonds, pts);
   const auto ghosted = [&] {
-    return std::vector<Vectors>{pts.u, pts.v, pts.theta, as_vectors(pts.p), as_vectors(pts.pf),
-                                as_vectors(pts.damage)};
+    return std::vector<Vectors>{
+        pts.u, pts.v, pts.theta, as_vectors(pts.p), as_vectors(pts.pf), as_vectors(pts.damage)};
   }();
   disc.dist.refresh(ghosted);
 
@@ -463,8 +479,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   if (rank == 0)
     csv = std::make_unique<io::CsvWriter>(
         folder + "/time_series.csv",
-        std::vector<std::string>{"step", "time", "max_displacement", "mean_damage",
-                                 "broken_bonds", "wall_seconds"},
+        std::vector<std::string>{"step", "time", "max_displacement", "mean_damage", "broken_bonds",
+                                 "wall_seconds"},
         !restart.empty());
 
   auto write_series = [&] {
@@ -477,7 +493,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
         "mupm::Diagnostics::globals", range(0, pts.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& m, double& d, double& v) {
           double s = 0;
-          for (int k = 0; k < Dim; ++k) s += u(i, k) * u(i, k);
+          for (int k = 0; k < Dim; ++k)
+            s += u(i, k) * u(i, k);
           m = s > m ? s : m;
           d += damage(i) * volume(i);
           v += volume(i);
@@ -499,8 +516,10 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
                 std::chrono::duration<double>(Clock::now() - t_start).count()});
   };
 
-  if (restart.empty()) fields.write(step, time);
-  if (restart.empty()) write_series();
+  if (restart.empty())
+    fields.write(step, time);
+  if (restart.empty())
+    write_series();
   const auto t_loop = Clock::now();
   auto t_last_progress = t_loop;
   const std::string checkpoint_path = folder + "/checkpoint.h5";
@@ -543,7 +562,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
         auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
         for (std::size_t i = 0; i < pts.n_owned; ++i)
           if (gid(i) == bad)
-            for (int k = 0; k < Dim; ++k) where[k] = x(i, k);
+            for (int k = 0; k < Dim; ++k)
+              where[k] = x(i, k);
         MPI_Allreduce(MPI_IN_PLACE, where, 3, MPI_DOUBLE, MPI_SUM, mpi);
         std::ostringstream s;
         s << "Error, a field is NaN or Inf at step " << step << " (t = " << time
@@ -553,15 +573,16 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
         throw CollectiveError(s.str());
       }
     }
-    if (step % series_interval == 0 || step == last_step) write_series();
+    if (step % series_interval == 0 || step == last_step)
+      write_series();
     if ((field_interval > 0 && step % field_interval == 0) || step == last_step)
       fields.write(step, time);
     if (checkpoint_interval > 0 && step % checkpoint_interval == 0 && step != last_step)
       write_checkpoint(checkpoint_path, disc, step, time, fields.history());
     const auto now = Clock::now();
-    if (rank == 0 && (std::chrono::duration<double>(now - t_last_progress).count() >=
-                          progress_interval ||
-                      step == last_step)) {
+    if (rank == 0 &&
+        (std::chrono::duration<double>(now - t_last_progress).count() >= progress_interval ||
+         step == last_step)) {
       t_last_progress = now;
       const double el = std::chrono::duration<double>(now - t_loop).count();
       const double done = double(step - first_step), left = double(last_step - step);
@@ -569,7 +590,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
       std::snprintf(line, sizeof line,
                     "step %lld/%lld (%.1f%%)  t = %.6g s  elapsed %s  ETA %s  %.3g point-steps/s\n",
                     step, last_step, 100.0 * double(step) / double(last_step), time,
-                    format_seconds(el).c_str(), format_seconds(done > 0 ? el / done * left : 0).c_str(),
+                    format_seconds(el).c_str(),
+                    format_seconds(done > 0 ? el / done * left : 0).c_str(),
                     el > 0 ? double(n_global) * done / el : 0.0);
       out << line << std::flush;
     }
@@ -605,12 +627,12 @@ RunSummary run_simulation(const Teuchos::RCP<const Teuchos::Comm<int>>& comm,
   return input_dimension(input) == 2 ? run<2>(comm, input, out) : run<3>(comm, input, out);
 }
 
-#define MUPM_INSTANTIATE(D)                                                                  \
-  template std::vector<NamedField> state_fields<D>(const Points<D>&);                        \
-  template void apply_initial_conditions<D>(const std::vector<InitialCondition>&, Points<D>&); \
-  template void compute_damage<D>(const Bonds&, Points<D>&);                                 \
-  template void write_checkpoint<D>(const std::string&, const Discretization<D>&, long long, \
-                                    double, const std::vector<double>&);                     \
+#define MUPM_INSTANTIATE(D)                                                                     \
+  template std::vector<NamedField> state_fields<D>(const Points<D>&);                           \
+  template void apply_initial_conditions<D>(const std::vector<InitialCondition>&, Points<D>&);  \
+  template void compute_damage<D>(const Bonds&, Points<D>&);                                    \
+  template void write_checkpoint<D>(const std::string&, const Discretization<D>&, long long,    \
+                                    double, const std::vector<double>&);                        \
   template void read_checkpoint<D>(const std::string&, Discretization<D>&, long long&, double&, \
                                    std::vector<double>&);
 MUPM_INSTANTIATE(2)

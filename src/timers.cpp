@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <unordered_map>
 
 namespace mupm::timers {
@@ -26,9 +27,14 @@ State& state() {
 
 std::size_t slot(const char* name, bool region) {
   State& s = state();
+  // Kokkos labels each View's fill "Kokkos::View::initialization [label]": one row for all.
+  static const std::string init = "Kokkos::View::initialization";
+  if (std::strncmp(name, init.c_str(), init.size()) == 0)
+    name = "Kokkos::View::initialization";
   std::string key = (region ? "R:" : "K:") + std::string(name);
   auto it = s.index.find(key);
-  if (it != s.index.end()) return it->second;
+  if (it != s.index.end())
+    return it->second;
   s.entries.push_back(Entry{name, region, 0.0, 0});
   s.index.emplace(std::move(key), s.entries.size() - 1);
   return s.entries.size() - 1;
@@ -41,7 +47,8 @@ void begin_kernel(const char* name, const std::uint32_t, std::uint64_t* id) {
 }
 void end_kernel(std::uint64_t) {
   State& s = state();
-  if (s.kernels.empty()) return;
+  if (s.kernels.empty())
+    return;
   const auto [k, t0] = s.kernels.back();
   s.kernels.pop_back();
   s.entries[k].seconds += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -53,7 +60,8 @@ void push_region(const char* name) {
 }
 void pop_region() {
   State& s = state();
-  if (s.regions.empty()) return;
+  if (s.regions.empty())
+    return;
   const auto [k, t0] = s.regions.back();
   s.regions.pop_back();
   s.entries[k].seconds += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -63,7 +71,8 @@ void pop_region() {
 }  // namespace
 
 bool enable() {
-  if (std::getenv("KOKKOS_TOOLS_LIBS") || std::getenv("KOKKOS_PROFILE_LIBRARY")) return false;
+  if (std::getenv("KOKKOS_TOOLS_LIBS") || std::getenv("KOKKOS_PROFILE_LIBRARY"))
+    return false;
   namespace KT = Kokkos::Tools::Experimental;
   KT::set_begin_parallel_for_callback(begin_kernel);
   KT::set_end_parallel_for_callback(end_kernel);
@@ -78,7 +87,8 @@ bool enable() {
 }
 
 void disable() {
-  if (!state().enabled) return;
+  if (!state().enabled)
+    return;
   namespace KT = Kokkos::Tools::Experimental;
   KT::set_begin_parallel_for_callback(nullptr);
   KT::set_end_parallel_for_callback(nullptr);
@@ -99,7 +109,9 @@ void reset() {
   }
 }
 
-std::vector<Entry> local_entries() { return state().entries; }
+std::vector<Entry> local_entries() {
+  return state().entries;
+}
 
 void report(MPI_Comm comm, std::ostream& out) {
   int rank = 0, size = 1;
@@ -109,11 +121,13 @@ void report(MPI_Comm comm, std::ostream& out) {
   std::string labels;
   const auto mine = local_entries();
   if (rank == 0)
-    for (const auto& e : mine) labels += (e.region ? 'R' : 'K') + e.label + '\n';
+    for (const auto& e : mine)
+      labels += (e.region ? 'R' : 'K') + e.label + '\n';
   int len = static_cast<int>(labels.size());
   MPI_Bcast(&len, 1, MPI_INT, 0, comm);
   labels.resize(static_cast<std::size_t>(len));
-  if (len > 0) MPI_Bcast(&labels[0], len, MPI_CHAR, 0, comm);
+  if (len > 0)
+    MPI_Bcast(&labels[0], len, MPI_CHAR, 0, comm);
   std::vector<std::string> rows;
   for (std::size_t p = 0, q; p < labels.size(); p = q + 1) {
     q = labels.find('\n', p);
@@ -130,21 +144,24 @@ void report(MPI_Comm comm, std::ostream& out) {
   const int n = static_cast<int>(rows.size());
   MPI_Reduce(t.data(), tmin.data(), n, MPI_DOUBLE, MPI_MIN, 0, comm);
   MPI_Reduce(t.data(), tmax.data(), n, MPI_DOUBLE, MPI_MAX, 0, comm);
-  if (rank != 0) return;
+  if (rank != 0)
+    return;
   std::vector<std::size_t> order(rows.size());
-  for (std::size_t r = 0; r < order.size(); ++r) order[r] = r;
+  for (std::size_t r = 0; r < order.size(); ++r)
+    order[r] = r;
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    if (rows[a][0] != rows[b][0]) return rows[a][0] > rows[b][0];  // regions first
+    if (rows[a][0] != rows[b][0])
+      return rows[a][0] > rows[b][0];  // regions first
     return tmax[a] > tmax[b];
   });
   char line[256];
-  std::snprintf(line, sizeof line, "%-6s %-44s %10s %12s %12s\n", "kind", "label", "calls",
-                "min s", "max s");
+  std::snprintf(line, sizeof line, "%-6s %-52s %10s %12s %12s\n", "kind", "label", "calls", "min s",
+                "max s");
   out << "Kernel and region times over " << size << " rank(s):\n" << line;
   for (std::size_t r : order) {
-    std::snprintf(line, sizeof line, "%-6s %-44s %10lld %12.4f %12.4f\n",
-                  rows[r][0] == 'R' ? "region" : "kernel", rows[r].c_str() + 1, calls[r],
-                  tmin[r], tmax[r]);
+    std::snprintf(line, sizeof line, "%-6s %-52s %10lld %12.4f %12.4f\n",
+                  rows[r][0] == 'R' ? "region" : "kernel", rows[r].c_str() + 1, calls[r], tmin[r],
+                  tmax[r]);
     out << line;
   }
 }

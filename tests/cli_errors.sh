@@ -53,6 +53,16 @@ got=$?
 set -e
 [[ $got == 2 ]] && grep -qF "cannot read the input file" missing_file.out || fail "missing file: exit $got"
 echo "ok: missing_file (exit $got)"
+# A state that overflows stops both ranks at the step it appears, naming the point (exit 3).
+base '' '<Parameter name="Time Step" type="double" value="1e10"/>' | sed '$d' >inf.xml
+cat >>inf.xml <<'XML'
+  <ParameterList name="Initial Conditions"><ParameterList name="fast">
+    <Parameter name="Field" type="string" value="Velocity"/>
+    <Parameter name="Value" type="Array(double)" value="{1e300, 0}"/>
+  </ParameterList></ParameterList>
+</ParameterList>
+XML
+expect inf 3 'NaN or Inf at step 1' 'global id' 'reference position'
 # A valid input validates, and --print-defaults is XML that documents every parameter.
 base '' '' >valid.xml
 run 2 1 --validate valid.xml | grep -q "is valid" || fail "--validate of a valid input"

@@ -15,8 +15,12 @@ namespace {
 double value(GlobalId g, int field, int c) {
   return std::sin(1e-3 * double(g) * (field + 1) + c) / 3.0 + 1e-17 * double(g);
 }
-bool broken(GlobalId a, GlobalId b) { return (a + b) % 7 == 0; }
-double energy(GlobalId a, GlobalId b) { return std::sqrt(double(a * 31 + b)) / 7.0; }
+bool broken(GlobalId a, GlobalId b) {
+  return (a + b) % 7 == 0;
+}
+double energy(GlobalId a, GlobalId b) {
+  return std::sqrt(double(a * 31 + b)) / 7.0;
+}
 
 template <int Dim>
 void set_state(Discretization<Dim>& disc) {
@@ -25,7 +29,8 @@ void set_state(Discretization<Dim>& disc) {
   for (const auto& f : state_fields(disc.points)) {
     auto h = Kokkos::create_mirror_view(f.view);
     for (std::size_t i = 0; i < disc.points.n_owned; ++i)
-      for (std::size_t c = 0; c < h.extent(1); ++c) h(i, c) = value(gid(i), field, int(c));
+      for (std::size_t c = 0; c < h.extent(1); ++c)
+        h(i, c) = value(gid(i), field, int(c));
     Kokkos::deep_copy(f.view, h);
     ++field;
   }
@@ -93,7 +98,8 @@ void round_trip(const GridSpec<Dim>& g) {
   read_checkpoint(path, disc2, step, time, history);
   check_state(disc2);
   MPI_Barrier(MPI_COMM_WORLD);
-  if (test::world()->getRank() == 0) std::remove(path.c_str());
+  if (test::world()->getRank() == 0)
+    std::remove(path.c_str());
 }
 
 TEST(Checkpoint, RoundTripAcrossRankCounts2D) {
@@ -102,7 +108,9 @@ TEST(Checkpoint, RoundTripAcrossRankCounts2D) {
   round_trip(g);
 }
 
-TEST(Checkpoint, RoundTripAcrossRankCounts3D) { round_trip(test::box<3>({6, 5, 7}, 3.015)); }
+TEST(Checkpoint, RoundTripAcrossRankCounts3D) {
+  round_trip(test::box<3>({6, 5, 7}, 3.015));
+}
 
 TEST(Checkpoint, MismatchIsReportedOnEveryRank) {
   const std::string path = unique_path("mismatch");
@@ -118,7 +126,8 @@ TEST(Checkpoint, MismatchIsReportedOnEveryRank) {
   auto wider = discretize(test::world(), test::box<2>({10, 10}, 4.015));
   EXPECT_THROW(read_checkpoint(path, wider, step, time, history), CollectiveError);
   MPI_Barrier(MPI_COMM_WORLD);
-  if (test::world()->getRank() == 0) std::remove(path.c_str());
+  if (test::world()->getRank() == 0)
+    std::remove(path.c_str());
 }
 
 }  // namespace

@@ -9,7 +9,9 @@
 namespace mupm {
 namespace {
 
-double field_value(GlobalId g, int c) { return std::sin(0.37 * double(g) + 1.3 * c) * 1e3 + g; }
+double field_value(GlobalId g, int c) {
+  return std::sin(0.37 * double(g) + 1.3 * c) * 1e3 + g;
+}
 
 template <int Dim>
 void check_ghosts(const GridSpec<Dim>& g) {
@@ -21,7 +23,8 @@ void check_ghosts(const GridSpec<Dim>& g) {
   auto p = Kokkos::create_mirror_view(pts.p);
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const bool owned = i < pts.n_owned;
-    for (int d = 0; d < Dim; ++d) u(i, d) = owned ? field_value(gid(i), d) : NAN;
+    for (int d = 0; d < Dim; ++d)
+      u(i, d) = owned ? field_value(gid(i), d) : NAN;
     p(i) = owned ? -field_value(gid(i), 7) : NAN;
   }
   Kokkos::deep_copy(pts.u, u);
@@ -31,11 +34,13 @@ void check_ghosts(const GridSpec<Dim>& g) {
   Kokkos::deep_copy(p, pts.p);
   auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
   for (std::size_t i = pts.n_owned; i < pts.size(); ++i) {
-    for (int d = 0; d < Dim; ++d) ASSERT_EQ(u(i, d), field_value(gid(i), d)) << "ghost " << gid(i);
+    for (int d = 0; d < Dim; ++d)
+      ASSERT_EQ(u(i, d), field_value(gid(i), d)) << "ghost " << gid(i);
     ASSERT_EQ(p(i), -field_value(gid(i), 7));
     // Constants travelled once at set-up: the ghost's position is its owner's.
     const auto xg = test::position(g, gid(i));
-    for (int d = 0; d < Dim; ++d) ASSERT_EQ(x(i, d), xg[d]);
+    for (int d = 0; d < Dim; ++d)
+      ASSERT_EQ(x(i, d), xg[d]);
   }
   // Every neighbour of an owned point is present locally (owned or ghost).
   EXPECT_EQ(disc.dist.refresh_count(), 2u);
@@ -50,7 +55,9 @@ TEST(Distribution, GhostsEqualOwners2D) {
   check_ghosts(g);
 }
 
-TEST(Distribution, GhostsEqualOwners3D) { check_ghosts(test::box<3>({8, 7, 9}, 3.015)); }
+TEST(Distribution, GhostsEqualOwners3D) {
+  check_ghosts(test::box<3>({8, 7, 9}, 3.015));
+}
 
 // (gid_i, gid_j, intact) of every bond, gathered on rank 0 in gid order.
 template <int Dim>
@@ -69,22 +76,26 @@ std::vector<long long> global_bond_list(const Teuchos::RCP<const Comm>& comm,
       mine.push_back(in(b));
     }
   int size = comm->getSize(), rank = comm->getRank();
-  if (size == 1) return mine;
+  if (size == 1)
+    return mine;
   int count = int(mine.size());
   std::vector<int> counts(size), displs(size, 0);
   MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
-  for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  for (int r = 1; r < size; ++r)
+    displs[r] = displs[r - 1] + counts[r - 1];
   std::vector<long long> all(rank == 0 ? displs[size - 1] + counts[size - 1] : 0);
   MPI_Gatherv(mine.data(), count, MPI_LONG_LONG, all.data(), counts.data(), displs.data(),
               MPI_LONG_LONG, 0, MPI_COMM_WORLD);
   // Rows of the triples sorted by (gid_i, position in row): a stable sort on gid_i keeps each
   // row's own order.
   std::vector<std::array<long long, 3>> rows(all.size() / 3);
-  for (std::size_t k = 0; k < rows.size(); ++k) rows[k] = {all[3 * k], all[3 * k + 1], all[3 * k + 2]};
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    rows[k] = {all[3 * k], all[3 * k + 1], all[3 * k + 2]};
   std::stable_sort(rows.begin(), rows.end(),
                    [](const auto& a, const auto& b) { return a[0] < b[0]; });
   std::vector<long long> out;
-  for (const auto& r : rows) out.insert(out.end(), r.begin(), r.end());
+  for (const auto& r : rows)
+    out.insert(out.end(), r.begin(), r.end());
   return out;
 }
 
@@ -120,7 +131,8 @@ TEST(Distribution, PartitionCoversLattice) {
         ASSERT_EQ(owner[std::size_t(k)], -1) << "gid " << k << " owned twice";
         owner[std::size_t(k)] = r;
       }
-    for (int o : owner) ASSERT_GE(o, 0);
+    for (int o : owner)
+      ASSERT_GE(o, 0);
   }
 }
 

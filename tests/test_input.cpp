@@ -44,15 +44,15 @@ TEST(Input, ValidInputGetsDefaults) {
 }
 
 TEST(Input, ExtentsLayersRegions) {
-  auto pl = parse_input(xml(
-      "<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
-      "<Parameter name=\"Extents\" type=\"Array(double)\" value=\"{0.2, 0.1}\"/>"
-      "<Parameter name=\"Horizon\" type=\"double\" value=\"0.04\"/>"
-      "<Parameter name=\"Boundary Layers\" type=\"Array(string)\" value=\"{-y, +y}\"/>"
-      "<ParameterList name=\"Regions\"><ParameterList name=\"top\">"
-      "<Parameter name=\"Min\" type=\"Array(double)\" value=\"{0, 0.09}\"/>"
-      "<Parameter name=\"Max\" type=\"Array(double)\" value=\"{0.2, 0.1}\"/>"
-      "</ParameterList></ParameterList>"));
+  auto pl = parse_input(
+      xml("<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
+          "<Parameter name=\"Extents\" type=\"Array(double)\" value=\"{0.2, 0.1}\"/>"
+          "<Parameter name=\"Horizon\" type=\"double\" value=\"0.04\"/>"
+          "<Parameter name=\"Boundary Layers\" type=\"Array(string)\" value=\"{-y, +y}\"/>"
+          "<ParameterList name=\"Regions\"><ParameterList name=\"top\">"
+          "<Parameter name=\"Min\" type=\"Array(double)\" value=\"{0, 0.09}\"/>"
+          "<Parameter name=\"Max\" type=\"Array(double)\" value=\"{0.2, 0.1}\"/>"
+          "</ParameterList></ParameterList>"));
   validate_input(*pl);
   const auto g = grid_from_input<2>(*pl);
   EXPECT_EQ(g.counts[0], 20);
@@ -69,19 +69,20 @@ TEST(Input, ExtentsLayersRegions) {
 TEST(Input, UnknownParameter) {
   expect_error(xml(kOk + "<Parameter name=\"Spacingg\" type=\"double\" value=\"1\"/>"),
                {"Spacingg", "mupm->Discretization", "not found in the list of valid"});
-  expect_error(xml(kOk, "<ParameterList name=\"Solver\"><Parameter name=\"dt\" type=\"double\" "
-                        "value=\"1\"/></ParameterList>"),
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"dt\" type=\"double\" "
+                   "value=\"1\"/></ParameterList>"),
                {"dt", "mupm->Solver"});
-  expect_error(xml(kOk, "<ParameterList name=\"Materials\"><Parameter name=\"E\" type=\"double\" "
-                        "value=\"1\"/></ParameterList>"),
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Materials\"><Parameter name=\"E\" type=\"double\" "
+                   "value=\"1\"/></ParameterList>"),
                {"\"E\"", "mupm->Materials"});
 }
 
 TEST(Input, UnknownParameterInNamedSublist) {
-  expect_error(xml(kOk +
-                   "<ParameterList name=\"Regions\"><ParameterList name=\"top\">"
-                   "<Parameter name=\"Minimum\" type=\"Array(double)\" value=\"{0, 0}\"/>"
-                   "</ParameterList></ParameterList>"),
+  expect_error(xml(kOk + "<ParameterList name=\"Regions\"><ParameterList name=\"top\">"
+                         "<Parameter name=\"Minimum\" type=\"Array(double)\" value=\"{0, 0}\"/>"
+                         "</ParameterList></ParameterList>"),
                {"Minimum", "mupm->Discretization->Regions->top"});
 }
 
@@ -89,20 +90,23 @@ TEST(Input, WrongType) {
   expect_error(xml("<Parameter name=\"Spacing\" type=\"string\" value=\"small\"/>"
                    "<Parameter name=\"Counts\" type=\"Array(int)\" value=\"{10, 8}\"/>"),
                {"Spacing", "mupm->Discretization", "double"});
-  expect_error(xml(kOk, "<ParameterList name=\"Solver\"><Parameter name=\"Number of Steps\" "
-                        "type=\"double\" value=\"1.5\"/></ParameterList>"),
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"Number of Steps\" "
+                   "type=\"double\" value=\"1.5\"/></ParameterList>"),
                {"Number of Steps", "mupm->Solver", "int"});
 }
 
 TEST(Input, OutOfRange) {
-  expect_error(xml(kOk, "<ParameterList name=\"Solver\"><Parameter name=\"Time Step\" "
-                        "type=\"double\" value=\"-1e-6\"/></ParameterList>"),
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"Time Step\" "
+                   "type=\"double\" value=\"-1e-6\"/></ParameterList>"),
                {"Time Step", "mupm->Solver", "-1e-06"});
   expect_error(xml(kOk + "<Parameter name=\"Dimension\" type=\"int\" value=\"4\"/>"),
                {"Dimension", "mupm->Discretization"});
-  expect_error(xml(kOk, "<ParameterList name=\"Output\"><Parameter name=\"Fields\" "
-                        "type=\"Array(string)\" value=\"{displacement, temperature}\"/>"
-                        "</ParameterList>"),
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Output\"><Parameter name=\"Fields\" "
+                   "type=\"Array(string)\" value=\"{displacement, temperature}\"/>"
+                   "</ParameterList>"),
                {"Fields", "mupm->Output", "temperature"});
 }
 
@@ -124,12 +128,29 @@ TEST(Input, InconsistentValues) {
   expect_error(xml(kOk + "<Parameter name=\"Boundary Layers\" type=\"Array(string)\" "
                          "value=\"{+z}\"/>"),
                {"Boundary Layers", "+z"});
-  expect_error(xml(kOk, "<ParameterList name=\"Initial Conditions\"><ParameterList name=\"v\">"
-                        "<Parameter name=\"Field\" type=\"string\" value=\"Velocity\"/>"
-                        "<Parameter name=\"Region\" type=\"string\" value=\"nowhere\"/>"
-                        "<Parameter name=\"Value\" type=\"Array(double)\" value=\"{1, 0}\"/>"
-                        "</ParameterList></ParameterList>"),
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Initial Conditions\"><ParameterList name=\"v\">"
+                   "<Parameter name=\"Field\" type=\"string\" value=\"Velocity\"/>"
+                   "<Parameter name=\"Region\" type=\"string\" value=\"nowhere\"/>"
+                   "<Parameter name=\"Value\" type=\"Array(double)\" value=\"{1, 0}\"/>"
+                   "</ParameterList></ParameterList>"),
                {"mupm->Initial Conditions->v->Region", "nowhere"});
+}
+
+TEST(Input, NumbersAreReadStrictly) {
+  // Teuchos alone would read these as 0.
+  expect_error(xml(kOk + "<Parameter name=\"Origin\" type=\"Array(double)\" value=\"{0, abc}\"/>"),
+               {"mupm->Discretization->Origin", "abc", "not a finite double"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"Time Step\" "
+                   "type=\"double\" value=\"1e-3x\"/></ParameterList>"),
+               {"mupm->Solver->Time Step", "1e-3x"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"Number of Steps\" "
+                   "type=\"int\" value=\"10.5\"/></ParameterList>"),
+               {"mupm->Solver->Number of Steps", "not a finite int"});
+  expect_error(xml(kOk + "<Parameter name=\"Horizon\" type=\"double\" value=\"nan\"/>"),
+               {"mupm->Discretization->Horizon", "nan"});
 }
 
 TEST(Input, MalformedXml) {

@@ -34,26 +34,34 @@ void check_against_brute_force(const GridSpec<Dim>& g, const std::vector<FlatCra
   long long checked = 0;
   for (std::size_t i = 0; i < pts.n_owned; ++i) {
     const auto xi = test::position(g, gid(i));
-    for (int d = 0; d < Dim; ++d) ASSERT_DOUBLE_EQ(x(i, d), xi[d]);
+    for (int d = 0; d < Dim; ++d)
+      ASSERT_DOUBLE_EQ(x(i, d), xi[d]);
     std::vector<std::pair<GlobalId, int>> expected;  // (gid, intact), ascending gid
     for (GlobalId j = 0; j < n_global; ++j) {
-      if (j == gid(i)) continue;
+      if (j == gid(i))
+        continue;
       const auto xj = test::position(g, j);
       double r2 = 0;
-      for (int d = 0; d < Dim; ++d) r2 += (xj[d] - xi[d]) * (xj[d] - xi[d]);
-      if (std::sqrt(r2) > g.horizon * (1 + 1e-9)) continue;
+      for (int d = 0; d < Dim; ++d)
+        r2 += (xj[d] - xi[d]) * (xj[d] - xi[d]);
+      if (std::sqrt(r2) > g.horizon * (1 + 1e-9))
+        continue;
       int ok = 1;
       for (const auto& c : flat) {
         const double si = xi[c.axis] - c.level, sj = xj[c.axis] - c.level;
-        if (si * sj >= 0) continue;
+        if (si * sj >= 0)
+          continue;
         const double t = si / (si - sj);
         bool inside = true;
         for (int d = 0; d < Dim; ++d) {
-          if (d == c.axis) continue;
+          if (d == c.axis)
+            continue;
           const double xc = xi[d] + t * (xj[d] - xi[d]);
-          if (xc < c.lo[d] || xc > c.hi[d]) inside = false;
+          if (xc < c.lo[d] || xc > c.hi[d])
+            inside = false;
         }
-        if (inside) ok = 0;
+        if (inside)
+          ok = 0;
       }
       expected.emplace_back(j, ok);
     }
@@ -116,11 +124,13 @@ void check_shape_tensor(double factor, double k11_units, long long n_neighbors) 
   auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.offsets);
   // The centre point has a full family.
   GlobalId centre = 0;
-  for (int d = Dim - 1; d >= 0; --d) centre = centre * n + n / 2;
+  for (int d = Dim - 1; d >= 0; --d)
+    centre = centre * n + n / 2;
   const double v = std::pow(dx, Dim) * (Dim == 2 ? g.thickness : 1.0);
   int found = 0;
   for (std::size_t i = 0; i < disc.points.n_owned; ++i) {
-    if (gid(i) != centre) continue;
+    if (gid(i) != centre)
+      continue;
     found = 1;
     EXPECT_EQ(off(i + 1) - off(i), n_neighbors);
     // K11 = sum xi_x^2 V = (sum over neighbours of (k dx)^2) dx^Dim

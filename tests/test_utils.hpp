@@ -11,7 +11,9 @@
 
 namespace mupm::test {
 
-inline Teuchos::RCP<const Comm> world() { return Tpetra::getDefaultComm(); }
+inline Teuchos::RCP<const Comm> world() {
+  return Tpetra::getDefaultComm();
+}
 inline Teuchos::RCP<const Comm> self() {
   return Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
 }

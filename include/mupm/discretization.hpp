@@ -33,7 +33,8 @@ void exchange_constants(Distribution& dist, Points<Dim>& pts) {
   auto frac = pts.fracture;
   Kokkos::parallel_for(
       "mupm::Comm::pack_constants", range(0, n_own), KOKKOS_LAMBDA(const std::size_t i) {
-        for (int d = 0; d < Dim; ++d) buf(i, d) = x(i, d);
+        for (int d = 0; d < Dim; ++d)
+          buf(i, d) = x(i, d);
         buf(i, Dim) = vol(i);
         buf(i, Dim + 1) = double(flags(i));  // uint32 values are exact in a double
         buf(i, Dim + 2) = double(regions(i));
@@ -42,7 +43,8 @@ void exchange_constants(Distribution& dist, Points<Dim>& pts) {
   dist.refresh({buf});
   Kokkos::parallel_for(
       "mupm::Comm::unpack_constants", range(n_own, n), KOKKOS_LAMBDA(const std::size_t i) {
-        for (int d = 0; d < Dim; ++d) x(i, d) = buf(i, d);
+        for (int d = 0; d < Dim; ++d)
+          x(i, d) = buf(i, d);
         vol(i) = buf(i, Dim);
         flags(i) = std::uint32_t(buf(i, Dim + 1));
         regions(i) = std::uint32_t(buf(i, Dim + 2));
@@ -67,7 +69,8 @@ Discretization<Dim> discretize(const Teuchos::RCP<const Comm>& comm, const GridS
   {
     auto gid = Kokkos::create_mirror_view(disc.points.gid);
     Kokkos::deep_copy(gid, disc.points.gid);
-    for (std::size_t k = 0; k < ghosts.size(); ++k) gid(owned.size() + k) = ghosts[k];
+    for (std::size_t k = 0; k < ghosts.size(); ++k)
+      gid(owned.size() + k) = ghosts[k];
     Kokkos::deep_copy(disc.points.gid, gid);
   }
   exchange_constants(disc.dist, disc.points);

@@ -22,7 +22,9 @@ using Comm = Teuchos::Comm<int>;
 
 // A rank-1 View seen as a [n][1] rank-2 View over the same memory (LayoutRight), so scalar and
 // vector fields travel through one code path.
-inline Vectors as_vectors(const Scalars& s) { return Vectors(s.data(), s.extent(0), 1); }
+inline Vectors as_vectors(const Scalars& s) {
+  return Vectors(s.data(), s.extent(0), 1);
+}
 
 class Distribution {
  public:

@@ -30,7 +30,8 @@ KOKKOS_INLINE_FUNCTION bool within_horizon(double d2, double delta2) {
 template <int Dim>
 KOKKOS_INLINE_FUNCTION bool in_box(const Box& b, const double* x, double tol) {
   for (int d = 0; d < Dim; ++d)
-    if (x[d] < b.lo[d] - tol || x[d] > b.hi[d] + tol) return false;
+    if (x[d] < b.lo[d] - tol || x[d] > b.hi[d] + tol)
+      return false;
   return true;
 }
 
@@ -46,7 +47,8 @@ KOKKOS_INLINE_FUNCTION bool bond_crosses(const Crack& c, const double* p, const 
   if constexpr (Dim == 2) {
     const double d1 = orient2d(c.a, c.b, p);
     const double d2 = orient2d(c.a, c.b, q);
-    if (!(d1 * d2 < 0.0)) return false;
+    if (!(d1 * d2 < 0.0))
+      return false;
     const double d3 = orient2d(p, q, c.a);
     const double d4 = orient2d(p, q, c.b);
     return d3 * d4 <= 0.0;
@@ -58,7 +60,8 @@ KOKKOS_INLINE_FUNCTION bool bond_crosses(const Crack& c, const double* p, const 
       sp += n[d] * (p[d] - c.a[d]);
       sq += n[d] * (q[d] - c.a[d]);
     }
-    if (!(sp * sq < 0.0)) return false;
+    if (!(sp * sq < 0.0))
+      return false;
     const double t = sp / (sp - sq);
     double s1 = 0, s2 = 0, e1 = 0, e2 = 0;
     for (int d = 0; d < 3; ++d) {

@@ -16,11 +16,11 @@ namespace mupm {
 
 template <int Dim>
 struct GridSpec {
-  std::array<double, Dim> origin{};        // lower corner of the real body
-  std::array<long long, Dim> counts{};     // real points per axis
-  double dx = 0;                           // spacing
-  double horizon = 0;                      // delta (absolute)
-  double thickness = 1;                    // out-of-plane thickness (2D)
+  std::array<double, Dim> origin{};              // lower corner of the real body
+  std::array<long long, Dim> counts{};           // real points per axis
+  double dx = 0;                                 // spacing
+  double horizon = 0;                            // delta (absolute)
+  double thickness = 1;                          // out-of-plane thickness (2D)
   std::array<std::array<int, 2>, Dim> layers{};  // boundary-layer rows on face (axis, side)
   std::vector<Crack> cracks;
   std::vector<std::string> region_names;
@@ -31,12 +31,14 @@ struct GridSpec {
   long long lattice_count(int d) const { return counts[d] + layers[d][0] + layers[d][1]; }
   long long n_global() const {
     long long n = 1;
-    for (int d = 0; d < Dim; ++d) n *= lattice_count(d);
+    for (int d = 0; d < Dim; ++d)
+      n *= lattice_count(d);
     return n;
   }
   double point_volume() const {
     double v = Dim == 2 ? thickness : 1.0;
-    for (int d = 0; d < Dim; ++d) v *= dx;
+    for (int d = 0; d < Dim; ++d)
+      v *= dx;
     return v;
   }
 };
@@ -47,7 +49,8 @@ struct LatticeBox {
   std::array<long long, Dim> lo{}, hi{};
   long long size() const {
     long long n = 1;
-    for (int d = 0; d < Dim; ++d) n *= (hi[d] > lo[d] ? hi[d] - lo[d] : 0);
+    for (int d = 0; d < Dim; ++d)
+      n *= (hi[d] > lo[d] ? hi[d] - lo[d] : 0);
     return n;
   }
 };
@@ -58,12 +61,14 @@ struct LatticeBox {
 template <int Dim>
 LatticeBox<Dim> partition_lattice(const GridSpec<Dim>& g, int n_ranks, int rank) {
   LatticeBox<Dim> box;
-  for (int d = 0; d < Dim; ++d) box.hi[d] = g.lattice_count(d);
+  for (int d = 0; d < Dim; ++d)
+    box.hi[d] = g.lattice_count(d);
   int first = 0, count = n_ranks;
   while (count > 1) {
     int axis = 0;
     for (int d = 1; d < Dim; ++d)
-      if (box.hi[d] - box.lo[d] > box.hi[axis] - box.lo[axis]) axis = d;
+      if (box.hi[d] - box.lo[d] > box.hi[axis] - box.lo[axis])
+        axis = d;
     const int left = count / 2;
     const long long extent = box.hi[axis] - box.lo[axis];
     const long long cut = box.lo[axis] + (extent * left + count / 2) / count;
@@ -82,7 +87,8 @@ LatticeBox<Dim> partition_lattice(const GridSpec<Dim>& g, int n_ranks, int rank)
 template <int Dim>
 KOKKOS_INLINE_FUNCTION GlobalId lattice_gid(const long long* idx, const long long* n) {
   GlobalId g = idx[Dim - 1];
-  for (int d = Dim - 2; d >= 0; --d) g = g * n[d] + idx[d];
+  for (int d = Dim - 2; d >= 0; --d)
+    g = g * n[d] + idx[d];
   return g;
 }
 
@@ -92,9 +98,12 @@ std::vector<GlobalId> box_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& b)
   std::vector<GlobalId> out;
   out.reserve(static_cast<std::size_t>(b.size()));
   long long n[Dim], idx[Dim];
-  for (int d = 0; d < Dim; ++d) n[d] = g.lattice_count(d);
-  if (b.size() == 0) return out;
-  for (int d = 0; d < Dim; ++d) idx[d] = b.lo[d];
+  for (int d = 0; d < Dim; ++d)
+    n[d] = g.lattice_count(d);
+  if (b.size() == 0)
+    return out;
+  for (int d = 0; d < Dim; ++d)
+    idx[d] = b.lo[d];
   while (true) {
     out.push_back(lattice_gid<Dim>(idx, n));
     int d = 0;
@@ -102,7 +111,8 @@ std::vector<GlobalId> box_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& b)
       idx[d] = b.lo[d];
       ++d;
     }
-    if (d == Dim) break;
+    if (d == Dim)
+      break;
   }
   return out;
 }
@@ -113,7 +123,8 @@ std::vector<GlobalId> box_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& b)
 template <int Dim>
 std::vector<GlobalId> ghost_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& b) {
   std::vector<GlobalId> out;
-  if (b.size() == 0) return out;
+  if (b.size() == 0)
+    return out;
   const long long m = g.layer_rows();
   LatticeBox<Dim> wide;
   long long n[Dim];
@@ -124,22 +135,26 @@ std::vector<GlobalId> ghost_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& 
   }
   const double delta2 = (g.horizon / g.dx) * (g.horizon / g.dx);
   long long idx[Dim];
-  for (int d = 0; d < Dim; ++d) idx[d] = wide.lo[d];
+  for (int d = 0; d < Dim; ++d)
+    idx[d] = wide.lo[d];
   while (true) {
     double d2 = 0;
     bool inside = true;
     for (int d = 0; d < Dim; ++d) {
       const long long c = std::min(std::max(idx[d], b.lo[d]), b.hi[d] - 1);
-      if (c != idx[d]) inside = false;
+      if (c != idx[d])
+        inside = false;
       d2 += double(c - idx[d]) * double(c - idx[d]);
     }
-    if (!inside && within_horizon(d2, delta2)) out.push_back(lattice_gid<Dim>(idx, n));
+    if (!inside && within_horizon(d2, delta2))
+      out.push_back(lattice_gid<Dim>(idx, n));
     int d = 0;
     while (d < Dim && ++idx[d] == wide.hi[d]) {
       idx[d] = wide.lo[d];
       ++d;
     }
-    if (d == Dim) break;
+    if (d == Dim)
+      break;
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -152,17 +167,20 @@ void fill_owned_from_lattice(const GridSpec<Dim>& g, const std::vector<GlobalId>
                              Points<Dim>& pts) {
   const std::size_t n = owned_gids.size();
   auto gid_host = Kokkos::create_mirror_view(pts.gid);
-  for (std::size_t i = 0; i < n; ++i) gid_host(i) = owned_gids[i];
+  for (std::size_t i = 0; i < n; ++i)
+    gid_host(i) = owned_gids[i];
   Kokkos::deep_copy(pts.gid, gid_host);
 
   View1<Crack> cracks("mupm::cracks", g.cracks.size());
   View1<Box> regions("mupm::regions", g.regions.size());
   {
     auto ch = Kokkos::create_mirror_view(cracks);
-    for (std::size_t c = 0; c < g.cracks.size(); ++c) ch(c) = g.cracks[c];
+    for (std::size_t c = 0; c < g.cracks.size(); ++c)
+      ch(c) = g.cracks[c];
     Kokkos::deep_copy(cracks, ch);
     auto rh = Kokkos::create_mirror_view(regions);
-    for (std::size_t r = 0; r < g.regions.size(); ++r) rh(r) = g.regions[r];
+    for (std::size_t r = 0; r < g.regions.size(); ++r)
+      rh(r) = g.regions[r];
     Kokkos::deep_copy(regions, rh);
   }
   Kokkos::Array<long long, Dim> lat, lo_layers, real;
@@ -190,16 +208,21 @@ void fill_owned_from_lattice(const GridSpec<Dim>& g, const std::vector<GlobalId>
           rest /= lat[d];
           xi[d] = origin[d] + (double(k) + 0.5) * dx;
           x(i, d) = xi[d];
-          if (k < 0) f |= kFlagBoundaryLayer | layer_face_flag(d, 0);
-          if (k >= real[d]) f |= kFlagBoundaryLayer | layer_face_flag(d, 1);
+          if (k < 0)
+            f |= kFlagBoundaryLayer | layer_face_flag(d, 0);
+          if (k >= real[d])
+            f |= kFlagBoundaryLayer | layer_face_flag(d, 1);
         }
         std::uint8_t frac = 0;
         for (std::size_t c = 0; c < cracks.extent(0); ++c)
-          if (distance2_to_crack<Dim>(cracks(c), xi) < dx * dx) frac = 1;
-        if (frac) f |= kFlagPreCrack;
+          if (distance2_to_crack<Dim>(cracks(c), xi) < dx * dx)
+            frac = 1;
+        if (frac)
+          f |= kFlagPreCrack;
         std::uint32_t r_bits = 0;
         for (std::size_t r = 0; r < regions.extent(0); ++r)
-          if (in_box<Dim>(regions(r), xi, tol)) r_bits |= 1u << r;
+          if (in_box<Dim>(regions(r), xi, tol))
+            r_bits |= 1u << r;
         volume(i) = vol;
         flags(i) = f;
         region_bits(i) = r_bits;

@@ -20,8 +20,10 @@ KOKKOS_INLINE_FUNCTION void heap_sort(Key* keys, Val* vals, long n) {
   auto sift = [&](long root, long end) {
     while (2 * root + 1 < end) {
       long child = 2 * root + 1;
-      if (child + 1 < end && keys[child] < keys[child + 1]) ++child;
-      if (!(keys[root] < keys[child])) return;
+      if (child + 1 < end && keys[child] < keys[child + 1])
+        ++child;
+      if (!(keys[root] < keys[child]))
+        return;
       Key tk = keys[root];
       keys[root] = keys[child];
       keys[child] = tk;
@@ -31,7 +33,8 @@ KOKKOS_INLINE_FUNCTION void heap_sort(Key* keys, Val* vals, long n) {
       root = child;
     }
   };
-  for (long s = n / 2 - 1; s >= 0; --s) sift(s, n);
+  for (long s = n / 2 - 1; s >= 0; --s)
+    sift(s, n);
   for (long end = n - 1; end > 0; --end) {
     Key tk = keys[0];
     keys[0] = keys[end];
@@ -86,7 +89,8 @@ Bonds build_bonds(const Points<Dim>& pts, double horizon, const std::vector<Crac
   };
   auto linear = KOKKOS_LAMBDA(const long* c) {
     long l = c[Dim - 1];
-    for (int d = Dim - 2; d >= 0; --d) l = l * nc[d] + c[d];
+    for (int d = Dim - 2; d >= 0; --d)
+      l = l * nc[d] + c[d];
     return l;
   };
 
@@ -102,9 +106,11 @@ Bonds build_bonds(const Points<Dim>& pts, double horizon, const std::vector<Crac
   Kokkos::parallel_scan(
       "mupm::Neighbors::bin_scan", Kokkos::RangePolicy<ExecSpace>(0, n_cells),
       KOKKOS_LAMBDA(const long c, int& sum, const bool final) {
-        if (final) cell_start(c) = sum;
+        if (final)
+          cell_start(c) = sum;
         sum += cell_count(c);
-        if (final && c == n_cells - 1) cell_start(n_cells) = sum;
+        if (final && c == n_cells - 1)
+          cell_start(n_cells) = sum;
       });
   Kokkos::deep_copy(cell_count, 0);
   Kokkos::parallel_for(
@@ -127,16 +133,21 @@ Bonds build_bonds(const Points<Dim>& pts, double horizon, const std::vector<Crac
       for (int d = 0; d < Dim; ++d) {
         c[d] = ci[d] + rest % 3 - 1;
         rest /= 3;
-        if (c[d] < 0 || c[d] >= nc[d]) ok = false;
+        if (c[d] < 0 || c[d] >= nc[d])
+          ok = false;
       }
-      if (!ok) continue;
+      if (!ok)
+        continue;
       const long l = linear(c);
       for (int k = cell_start(l); k < cell_start(l + 1); ++k) {
         const int j = cell_points(k);
-        if (std::size_t(j) == i) continue;
+        if (std::size_t(j) == i)
+          continue;
         double d2 = 0;
-        for (int d = 0; d < Dim; ++d) d2 += (x(j, d) - x(i, d)) * (x(j, d) - x(i, d));
-        if (within_horizon(d2, delta2)) f(j);
+        for (int d = 0; d < Dim; ++d)
+          d2 += (x(j, d) - x(i, d)) * (x(j, d) - x(i, d));
+        if (within_horizon(d2, delta2))
+          f(j);
       }
     }
   };
@@ -153,7 +164,8 @@ Bonds build_bonds(const Points<Dim>& pts, double horizon, const std::vector<Crac
       "mupm::Neighbors::scan", range(0, n_own + 1),
       KOKKOS_LAMBDA(const std::size_t i, BondIndex& sum, const bool final) {
         sum += offsets(i);
-        if (final) offsets(i) = sum;
+        if (final)
+          offsets(i) = sum;
       },
       n_bonds);
 
@@ -168,7 +180,8 @@ Bonds build_bonds(const Points<Dim>& pts, double horizon, const std::vector<Crac
   View1<Crack> cracks("mupm::cracks", crack_list.size());
   {
     auto ch = Kokkos::create_mirror_view(cracks);
-    for (std::size_t c = 0; c < crack_list.size(); ++c) ch(c) = crack_list[c];
+    for (std::size_t c = 0; c < crack_list.size(); ++c)
+      ch(c) = crack_list[c];
     Kokkos::deep_copy(cracks, ch);
   }
   Kokkos::parallel_for(
@@ -182,12 +195,15 @@ Bonds build_bonds(const Points<Dim>& pts, double horizon, const std::vector<Crac
         const BondIndex b0 = offsets(i);
         detail::heap_sort(&keys(b0), &neighbor(b0), long(offsets(i + 1) - b0));
         double xi[3] = {0, 0, 0}, xj[3] = {0, 0, 0};
-        for (int d = 0; d < Dim; ++d) xi[d] = x(i, d);
+        for (int d = 0; d < Dim; ++d)
+          xi[d] = x(i, d);
         for (BondIndex k = b0; k < offsets(i + 1); ++k) {
-          for (int d = 0; d < Dim; ++d) xj[d] = x(neighbor(k), d);
+          for (int d = 0; d < Dim; ++d)
+            xj[d] = x(neighbor(k), d);
           std::uint8_t ok = 1;
           for (std::size_t c = 0; c < cracks.extent(0); ++c)
-            if (bond_crosses<Dim>(cracks(c), xi, xj)) ok = 0;
+            if (bond_crosses<Dim>(cracks(c), xi, xj))
+              ok = 0;
           intact(k) = ok;
         }
       });

@@ -32,25 +32,25 @@ struct Points {
   std::size_t size() const { return n_owned + n_ghost; }
 
   // Constant per point: exchanged once.
-  GlobalIds gid;      // global id
-  Vectors x;          // reference position [n][Dim]
-  Scalars volume;     // V_i (2D: area times thickness)
-  Flags flags;        // PointFlag bits
-  Flags regions;      // bit r: the point lies in named region r
+  GlobalIds gid;   // global id
+  Vectors x;       // reference position [n][Dim]
+  Scalars volume;  // V_i (2D: area times thickness)
+  Flags flags;     // PointFlag bits
+  Flags regions;   // bit r: the point lies in named region r
   // Kinematics of the solid (central difference, eqs 127-136).
-  Vectors u, v, a;                // displacement, velocity, acceleration [n][Dim]
-  Vectors theta, omega, alpha;    // micro-rotation and its rates [n][RotDim]
+  Vectors u, v, a;              // displacement, velocity, acceleration [n][Dim]
+  Vectors theta, omega, alpha;  // micro-rotation and its rates [n][RotDim]
   // Fluid (eqs 141-146) and fracture fluid (eqs 119-120).
-  Scalars p, p_rate;              // pore water pressure and its rate
-  Scalars pf, pf_rate;            // fracture pressure and its rate
+  Scalars p, p_rate;    // pore water pressure and its rate
+  Scalars pf, pf_rate;  // fracture pressure and its rate
   Scalars porosity, saturation;
   // Fracture.
-  Scalars damage;                 // D_i (eq 37)
-  Bytes fracture;                 // 1: fracture point (D >= D_cr or next to a pre-crack)
+  Scalars damage;  // D_i (eq 37)
+  Bytes fracture;  // 1: fracture point (D >= D_cr or next to a pre-crack)
   // Constitutive state: effective stress, couple stress, equivalent plastic strain.
-  Vectors stress;                 // sigma-bar [n][Dim*Dim], row-major, non-symmetric
-  Vectors couple_stress;          // m [n][RotDim*Dim]
-  Scalars plastic_strain;         // equivalent plastic strain (eq 95)
+  Vectors stress;          // sigma-bar [n][Dim*Dim], row-major, non-symmetric
+  Vectors couple_stress;   // m [n][RotDim*Dim]
+  Scalars plastic_strain;  // equivalent plastic strain (eq 95)
 
   Points() = default;
   Points(std::size_t owned, std::size_t ghost) { allocate(owned, ghost); }

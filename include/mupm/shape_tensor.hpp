@@ -21,15 +21,19 @@ void compute_shape_tensor(const Points<Dim>& p, const Bonds& bonds, const Vector
       "mupm::Kinematics::shape_tensor", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         double k[Dim * Dim] = {};
         for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
-          if (!intact(b)) continue;
+          if (!intact(b))
+            continue;
           const int j = neighbor(b);
           double xi[Dim];
-          for (int d = 0; d < Dim; ++d) xi[d] = x(j, d) - x(i, d);
+          for (int d = 0; d < Dim; ++d)
+            xi[d] = x(j, d) - x(i, d);
           const double vj = volume(j);
           for (int r = 0; r < Dim; ++r)
-            for (int c = 0; c < Dim; ++c) k[r * Dim + c] += xi[r] * xi[c] * vj;
+            for (int c = 0; c < Dim; ++c)
+              k[r * Dim + c] += xi[r] * xi[c] * vj;
         }
-        for (int m = 0; m < Dim * Dim; ++m) K(i, m) = k[m];
+        for (int m = 0; m < Dim * Dim; ++m)
+          K(i, m) = k[m];
       });
 }
 

@@ -13,8 +13,8 @@ using MemSpace = ExecSpace::memory_space;
 using HostSpace = Kokkos::HostSpace;
 using DeviceType = Kokkos::Device<ExecSpace, MemSpace>;
 
-using LocalId = int;         // index of a point on one rank (owned first, then ghosts)
-using GlobalId = long long;  // rank-independent point id (Tpetra global ordinal)
+using LocalId = int;             // index of a point on one rank (owned first, then ghosts)
+using GlobalId = long long;      // rank-independent point id (Tpetra global ordinal)
 using BondIndex = std::int64_t;  // CSR offset: may exceed 2^31 on a large rank
 
 template <class T>
@@ -29,11 +29,11 @@ using Bytes = View1<std::uint8_t>;
 using GlobalIds = View1<GlobalId>;
 
 template <class T>
-using ConstRandomView1 =
-    Kokkos::View<const T*, Kokkos::LayoutRight, MemSpace, Kokkos::MemoryTraits<Kokkos::RandomAccess>>;
+using ConstRandomView1 = Kokkos::View<const T*, Kokkos::LayoutRight, MemSpace,
+                                      Kokkos::MemoryTraits<Kokkos::RandomAccess>>;
 template <class T>
-using ConstRandomView2 =
-    Kokkos::View<const T**, Kokkos::LayoutRight, MemSpace, Kokkos::MemoryTraits<Kokkos::RandomAccess>>;
+using ConstRandomView2 = Kokkos::View<const T**, Kokkos::LayoutRight, MemSpace,
+                                      Kokkos::MemoryTraits<Kokkos::RandomAccess>>;
 
 // Micro-rotation components: 1 in 2D (theta about z), 3 in 3D.
 template <int Dim>
