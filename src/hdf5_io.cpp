@@ -637,28 +637,31 @@ hid_t open_file(MPI_Comm comm, const std::string& path, bool create) {
 
 }  // namespace
 
-PointFile PointFile::create(MPI_Comm comm, const std::string& path) {
+namespace {
+
+// The file gets its own duplicate of the communicator, freed with the file (or here on failure).
+template <class Make>
+PointFile with_dup(MPI_Comm comm, Make&& make) {
   MPI_Comm dup = MPI_COMM_NULL;
   MPI_Comm_dup(comm, &dup);
   try {
-    const hid_t f = open_file(dup, path, true);
-    return PointFile(dup, f, path);
+    return make(dup);
   } catch (...) {
     MPI_Comm_free(&dup);
     throw;
   }
 }
 
+}  // namespace
+
+PointFile PointFile::create(MPI_Comm comm, const std::string& path) {
+  return with_dup(comm,
+                  [&](MPI_Comm dup) { return PointFile(dup, open_file(dup, path, true), path); });
+}
+
 PointFile PointFile::open(MPI_Comm comm, const std::string& path) {
-  MPI_Comm dup = MPI_COMM_NULL;
-  MPI_Comm_dup(comm, &dup);
-  try {
-    const hid_t f = open_file(dup, path, false);
-    return PointFile(dup, f, path);
-  } catch (...) {
-    MPI_Comm_free(&dup);
-    throw;
-  }
+  return with_dup(comm,
+                  [&](MPI_Comm dup) { return PointFile(dup, open_file(dup, path, false), path); });
 }
 
 PointFile::PointFile(PointFile&& other) noexcept

@@ -92,28 +92,35 @@ KOKKOS_INLINE_FUNCTION GlobalId lattice_gid(const long long* idx, const long lon
   return g;
 }
 
-// Global ids of the points in a lattice box, ascending.
-template <int Dim>
-std::vector<GlobalId> box_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& b) {
-  std::vector<GlobalId> out;
-  out.reserve(static_cast<std::size_t>(b.size()));
-  long long n[Dim], idx[Dim];
-  for (int d = 0; d < Dim; ++d)
-    n[d] = g.lattice_count(d);
+// Calls f(idx) for every lattice index of the box, x fastest (ascending global id).
+template <int Dim, class F>
+void for_each_in_box(const LatticeBox<Dim>& b, F&& f) {
   if (b.size() == 0)
-    return out;
+    return;
+  long long idx[Dim];
   for (int d = 0; d < Dim; ++d)
     idx[d] = b.lo[d];
   while (true) {
-    out.push_back(lattice_gid<Dim>(idx, n));
+    f(static_cast<const long long*>(idx));
     int d = 0;
     while (d < Dim && ++idx[d] == b.hi[d]) {
       idx[d] = b.lo[d];
       ++d;
     }
     if (d == Dim)
-      break;
+      return;
   }
+}
+
+// Global ids of the points in a lattice box, ascending.
+template <int Dim>
+std::vector<GlobalId> box_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& b) {
+  std::vector<GlobalId> out;
+  out.reserve(static_cast<std::size_t>(b.size()));
+  long long n[Dim];
+  for (int d = 0; d < Dim; ++d)
+    n[d] = g.lattice_count(d);
+  for_each_in_box(b, [&](const long long* idx) { out.push_back(lattice_gid<Dim>(idx, n)); });
   return out;
 }
 
@@ -134,10 +141,7 @@ std::vector<GlobalId> ghost_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& 
     wide.hi[d] = std::min(n[d], b.hi[d] + m);
   }
   const double delta2 = (g.horizon / g.dx) * (g.horizon / g.dx);
-  long long idx[Dim];
-  for (int d = 0; d < Dim; ++d)
-    idx[d] = wide.lo[d];
-  while (true) {
+  for_each_in_box(wide, [&](const long long* idx) {
     double d2 = 0;
     bool inside = true;
     for (int d = 0; d < Dim; ++d) {
@@ -148,16 +152,8 @@ std::vector<GlobalId> ghost_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& 
     }
     if (!inside && within_horizon(d2, delta2))
       out.push_back(lattice_gid<Dim>(idx, n));
-    int d = 0;
-    while (d < Dim && ++idx[d] == wide.hi[d]) {
-      idx[d] = wide.lo[d];
-      ++d;
-    }
-    if (d == Dim)
-      break;
-  }
-  std::sort(out.begin(), out.end());
-  return out;
+  });
+  return out;  // ascending: the walk is in global-id order
 }
 
 // Fills gid, x, volume, flags and regions of the owned points from their global ids, and marks
