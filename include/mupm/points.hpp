@@ -37,6 +37,7 @@ struct Points {
   Scalars volume;  // V_i (2D: area times thickness)
   Flags flags;     // PointFlag bits
   Flags regions;   // bit r: the point lies in named region r
+  Flags fixed;     // bit d: u_d prescribed; bit Dim + r: theta_r prescribed (boundary conditions)
   // Kinematics of the solid (central difference, eqs 127-136).
   Vectors u, v, a;              // displacement, velocity, acceleration [n][Dim]
   Vectors theta, omega, alpha;  // micro-rotation and its rates [n][RotDim]
@@ -64,6 +65,7 @@ struct Points {
     volume = Scalars("mupm::volume", n);
     flags = Flags("mupm::flags", n);
     regions = Flags("mupm::regions", n);
+    fixed = Flags("mupm::fixed", n);
     u = Vectors("mupm::u", n, Dim);
     v = Vectors("mupm::v", n, Dim);
     a = Vectors("mupm::a", n, Dim);
@@ -85,7 +87,7 @@ struct Points {
 
   // Resident bytes of one point (all fields above).
   static constexpr std::size_t bytes_per_point() {
-    return sizeof(GlobalId) + sizeof(double) * (Dim + 1) + 2 * sizeof(std::uint32_t) +
+    return sizeof(GlobalId) + sizeof(double) * (Dim + 1) + 3 * sizeof(std::uint32_t) +
            sizeof(double) * (3 * Dim + 3 * rot_dim + 4 + 2 + 1) + 1 +
            sizeof(double) * (Dim * Dim + rot_dim * Dim + 1);
   }

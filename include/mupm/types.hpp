@@ -35,6 +35,8 @@ template <class T>
 using ConstRandomView2 = Kokkos::View<const T**, Kokkos::LayoutRight, MemSpace,
                                       Kokkos::MemoryTraits<Kokkos::RandomAccess>>;
 
+inline constexpr double kPi = 3.14159265358979323846;
+
 // Micro-rotation components: 1 in 2D (theta about z), 3 in 3D.
 template <int Dim>
 inline constexpr int kRotDim = Dim == 2 ? 1 : 3;
