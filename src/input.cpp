@@ -62,6 +62,28 @@ void ic_template(ParameterList& c) {
   c.set("Value", Array<double>(), "The value (number of entries as Field says).");
 }
 
+void bc_template(ParameterList& c) {
+  c.set("Type", std::string("Displacement"),
+        "Displacement [m], Velocity [m/s] or Micro-Rotation [rad] prescribed on the region's "
+        "points (the boundary-layer method: use a boundary layer region), or Traction [Pa] "
+        "applied as a body force traction/dx on the region's points (make it the outermost real "
+        "row of the face), or Body Force [N/m^3].",
+        one_of({"Displacement", "Velocity", "Micro-Rotation", "Traction", "Body Force"}));
+  c.set("Region", std::string("All"), "Region name (Discretization->Regions, 'Layer -y', All).");
+  c.set("Component", std::string("x"),
+        "x, y or z: the displacement/velocity/traction/force component, or the rotation axis "
+        "(2D micro-rotation: z).",
+        one_of({"x", "y", "z"}));
+  c.set("Value", 0.0, "The value, times the time function.");
+  c.set("Time Function", std::string("Constant"),
+        "Constant: Value. Ramp: Value * min(t / Ramp Time, 1). Rate: Value * t. Table: Value * "
+        "the piecewise-linear table (Times, Values), held constant outside it.",
+        one_of({"Constant", "Ramp", "Rate", "Table"}));
+  c.set("Ramp Time", 0.0, "Ramp duration [s] (Time Function = Ramp).", at_least(0.0));
+  c.set("Times", Array<double>(), "Table times [s], increasing (Time Function = Table).");
+  c.set("Values", Array<double>(), "Table values (Time Function = Table), as many as Times.");
+}
+
 // The user-named sublists: validated against their template one by one, not by Teuchos'
 // recursion.
 const std::vector<std::pair<std::string, void (*)(ParameterList&)>> kNamedSublists = {
@@ -111,9 +133,14 @@ RCP<ParameterList> valid_parameters() {
     d.set("Horizon", 0.0, "Horizon delta [m]; 0: use Horizon Factor. Give one of the two.",
           at_least(0.0));
     d.set("Thickness", 1.0, "Out-of-plane thickness [m] (2D only).", positive());
+    d.set("Boundary Layer Horizons", 2.0,
+          "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
+          "default) gives the layer points next to the body full families too, which the "
+          "correspondence model needs for exact boundary values; the paper's layers are 1.",
+          positive());
     d.set("Boundary Layers", Array<std::string>(),
-          "Faces of the body that get a boundary layer of floor(delta/dx) rows of fictitious "
-          "points outside them (the paper's boundary-layer method), any of -x +x -y +y -z +z. "
+          "Faces of the body that get a boundary layer of fictitious points outside them (the "
+          "paper's boundary-layer method), any of -x +x -y +y -z +z. "
           "Each layer is also a region named 'Layer -y' etc.",
           rcp(new Teuchos::ArrayStringValidator(one_of(kFaces))));
     ParameterList& r = d.sublist("Regions", false,
@@ -127,12 +154,44 @@ RCP<ParameterList> valid_parameters() {
                                  "fracture points.");
     crack_template(c.sublist("NAME"));
   }
-  pl->sublist("Materials", false,
-              "Solid constitutive models (filled by the solid-mechanics issue).");
-  pl->sublist("Fluid", false, "Pore fluid properties (filled by the pore-fluid issue).");
+  {
+    ParameterList& m =
+        pl->sublist("Materials", false, "The solid (Solver->Physics = Micropolar Solid).");
+    m.set("Model", std::string("Micropolar Elastic"),
+          "Constitutive model: Micropolar Elastic (eqs 80-81).", one_of({"Micropolar Elastic"}));
+    m.set("Bulk Modulus", 0.0, "Drained bulk modulus K [Pa] (> 0 for a solid).", at_least(0.0));
+    m.set("Shear Modulus", 0.0, "Shear modulus mu [Pa] (> 0 for a solid).", at_least(0.0));
+    m.set("Micropolar Shear Modulus", 0.0, "Cosserat coupling modulus mu_c [Pa] (eq 80).",
+          at_least(0.0));
+    m.set("Length Scale", 0.0,
+          "Micropolar length scale l [m] (> 0 for a solid): couple-stress modulus mu l^2/2 "
+          "(eq 81) and micro-inertia (pi/2)(1 - phi) rho_s l^2 (eq 13).",
+          at_least(0.0));
+    m.set("Solid Density", 2000.0, "Density of the solid grains rho_s [kg/m^3].", positive());
+    m.set("Porosity", 0.0, "Initial porosity phi (0 <= phi < 1); Initial Conditions may override.",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 0.999999)));
+    m.set("Stabilization", 0.5, "Stabilization parameter G in [0, 1] (eqs 66-67).",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1.0)));
+    m.set("Stabilization Modulus", std::string("Automatic"),
+          "D of eqs 69-71. Eq 71: the paper's 3D D = E(1-4nu)/(4 pi delta^2 (1-nu-2nu^2)), "
+          "negative for nu > 1/4, then an error. Bulk Matching: D = 3K/(8 pi delta^2) in 3D, "
+          "(lambda+mu)/(6 pi h delta) in 2D (stabilization energy of a uniform expansion equal "
+          "to the elastic one; derivation in include/mupm/solid.hpp). Automatic: Eq 71 in 3D "
+          "where it is positive, Bulk Matching otherwise and always in 2D.",
+          one_of({"Automatic", "Eq 71", "Bulk Matching"}));
+  }
+  {
+    ParameterList& f = pl->sublist("Fluid", false,
+                                   "Pore fluid properties (flow comes with the pore-fluid issue).");
+    f.set("Water Density", 1000.0, "rho_w [kg/m^3], in the mixture density (eq 1).", positive());
+  }
   pl->sublist("Fracture", false, "Bond breakage and fracture flow (filled by the fracture issue).");
-  pl->sublist("Boundary Conditions", false,
-              "Prescribed fields on regions (filled by the solid-mechanics issue).");
+  {
+    ParameterList& b =
+        pl->sublist("Boundary Conditions", false, "One sublist per condition, named as you like.");
+    bc_template(b.sublist("NAME"));
+  }
+
   {
     ParameterList& ic = pl->sublist("Initial Conditions", false,
                                     "Initial fields, one sublist per condition, named as you "
@@ -141,13 +200,30 @@ RCP<ParameterList> valid_parameters() {
   }
   {
     ParameterList& s = pl->sublist("Solver", false, "Time stepping.");
-    s.set("Physics", std::string("Kinematics Only"),
-          "Physics advanced each step. 'Kinematics Only' (the only model so far): no internal "
-          "forces; displacement advances with the velocity by central difference, damage is "
-          "kept from the intact bonds (eq 37). Solid, fluid and fracture models come with later "
-          "issues.",
-          one_of({"Kinematics Only"}));
+    s.set("Physics", std::string("Micropolar Solid"),
+          "Physics advanced each step. Micropolar Solid: the stabilized micropolar "
+          "correspondence solid (Materials), explicit central difference. Kinematics Only: no "
+          "internal forces (points move with their velocity); damage from intact bonds (eq 37) "
+          "either way. Fluid and fracture models come with later issues.",
+          one_of({"Micropolar Solid", "Kinematics Only"}));
     s.set("Time Step", 1e-6, "Time step dt [s] (> 0).", positive());
+    s.set("Automatic Time Step", false,
+          "Use Time Step Safety Factor x the estimated stable step instead of Time Step.");
+    s.set("Time Step Safety Factor", 0.5,
+          "Fraction of the estimated stable step (power iteration on the discrete operator) used "
+          "by Automatic Time Step, and the limit above which Time Step draws a warning.",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(1e-6, 1.0)));
+    s.set("Gravity", Array<double>(),
+          "Gravitational acceleration [m/s^2] (Dim values; default 0).");
+    s.set("Damping", 0.0,
+          "Mass-proportional damping c [1/s] (a = f/rho - c v), for quasi-static runs by dynamic "
+          "relaxation; 0: none.",
+          at_least(0.0));
+    s.set("Energy Tolerance", 1e-2,
+          "Largest accepted |E_int + E_kin + D - W_ext - E_0| relative to the largest of those "
+          "terms (eqs 137-140); beyond it a warning with the step.",
+          at_least(0.0));
+    s.set("Stop On Energy Violation", false, "Stop the run when the energy balance is violated.");
     s.set("Number of Steps", 100, "Number of time steps (>= 0).", at_least(0));
     s.set("Restart From", std::string(""),
           "Checkpoint file (.h5) to continue from; empty: start at t = 0. The run may use a "
@@ -304,6 +380,9 @@ Array<T> get_array(const ParameterList& l, const std::string& name, std::size_t 
   return a;
 }
 
+void check_region(const ParameterList& c, const ParameterList& regions,
+                  const Array<std::string>& faces);
+
 void check_dimension_arrays(ParameterList& input) {
   ParameterList& d = input.sublist("Discretization");
   const int dim = d.get<int>("Dimension");
@@ -385,15 +464,62 @@ void check_dimension_arrays(ParameterList& input) {
                               ? (dim == 2 ? 1 : 3)
                               : 1;
     get_array<double>(c, "Value", n, field);
-    const std::string region = c.get<std::string>("Region");
-    bool known = region == "All" || regions.isSublist(region);
-    for (const auto& f : faces)
-      known = known || region == "Layer " + f;
-    if (!known)
-      throw InputError("Error, " + path_of(c, "Region") + " = '" + region +
-                       "' names no region; expected All, a sublist of " + regions.name() +
-                       " or a boundary layer such as 'Layer -y'.");
+    check_region(c, regions, faces);
   }
+  ParameterList& bcs = input.sublist("Boundary Conditions");
+  for (auto it = bcs.begin(); it != bcs.end(); ++it) {
+    ParameterList& c = bcs.sublist(bcs.name(it));
+    check_region(c, regions, faces);
+    const std::string type = c.get<std::string>("Type"), comp = c.get<std::string>("Component");
+    if (type == "Micro-Rotation" && dim == 2 && comp != "z")
+      throw InputError("Error, " + path_of(c, "Component") + " = " + comp +
+                       ": in 2D the micro-rotation is about z; write z.");
+    if (type != "Micro-Rotation" && comp[0] - 'x' >= dim)
+      throw InputError("Error, " + path_of(c, "Component") + " = " + comp + ": a " +
+                       std::to_string(dim) + "D body has components x" +
+                       (dim == 3 ? ", y and z." : " and y."));
+    const std::string tf = c.get<std::string>("Time Function");
+    if (tf == "Ramp" && !(c.get<double>("Ramp Time") > 0))
+      throw InputError("Error, " + path_of(c, "Ramp Time") + " must be > 0 for a Ramp.");
+    if (tf == "Table") {
+      const auto t = c.get<Array<double>>("Times"), v = c.get<Array<double>>("Values");
+      bool increasing = t.size() >= 2;
+      for (Teuchos::Ordinal k = 1; k < t.size(); ++k)
+        increasing = increasing && t[k] > t[k - 1];
+      if (!increasing || v.size() != t.size())
+        throw InputError("Error, " + c.name() +
+                         ": a Table needs at least 2 increasing Times and as many Values.");
+    }
+  }
+  const ParameterList& solver = input.sublist("Solver");
+  if (!solver.get<Array<double>>("Gravity").empty())
+    get_array<double>(solver, "Gravity", dim, "m/s^2");
+  if (solver.get<std::string>("Physics") == "Micropolar Solid") {
+    const ParameterList& m = input.sublist("Materials");
+    for (const char* k : {"Bulk Modulus", "Shear Modulus", "Length Scale"})
+      if (!(m.get<double>(k) > 0))
+        throw InputError("Error, " + path_of(m, k) +
+                         " must be > 0 for Solver->Physics = Micropolar Solid.");
+    const std::string sm = m.get<std::string>("Stabilization Modulus");
+    const double K = m.get<double>("Bulk Modulus"), mu = m.get<double>("Shear Modulus");
+    if (sm == "Eq 71" && (dim == 2 || mu - (K - 2 * mu / 3) <= 0))
+      throw InputError("Error, " + path_of(m, "Stabilization Modulus") + " = Eq 71 " +
+                       (dim == 2 ? std::string("is a 3D formula")
+                                 : std::string("gives D <= 0 (Poisson's ratio >= 1/4)")) +
+                       ": use Automatic or Bulk Matching.");
+  }
+}
+
+void check_region(const ParameterList& c, const ParameterList& regions,
+                  const Array<std::string>& faces) {
+  const std::string region = c.get<std::string>("Region");
+  bool known = region == "All" || regions.isSublist(region);
+  for (const auto& f : faces)
+    known = known || region == "Layer " + f;
+  if (!known)
+    throw InputError("Error, " + path_of(c, "Region") + " = '" + region +
+                     "' names no region; expected All, a sublist of " + regions.name() +
+                     " or a boundary layer such as 'Layer -y'.");
 }
 
 // Teuchos reads numbers with operator>>, which turns "abc" or "1e-3x" in an Array(double) into
@@ -534,7 +660,8 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
     g.counts[k] = counts.empty() ? std::llround(ext[k] / g.dx) : counts[k];
     g.origin[k] = origin.empty() ? 0.0 : origin[k];
   }
-  const int rows = g.layer_rows();
+  const int rows =
+      static_cast<int>(d.get<double>("Boundary Layer Horizons") * g.horizon / g.dx * (1 + 1e-10));
   for (const auto& f : d.get<Array<std::string>>("Boundary Layers"))
     g.layers[f[1] - 'x'][f[0] == '-' ? 0 : 1] = rows;
   const ParameterList& regions = d.sublist("Regions");
@@ -594,14 +721,16 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
 template GridSpec<2> grid_from_input<2>(const ParameterList&);
 template GridSpec<3> grid_from_input<3>(const ParameterList&);
 
-std::vector<InitialCondition> initial_conditions_from_input(const ParameterList& input) {
+namespace {
+
+// Region names in bit order: the user's regions, then the boundary layers (as grid_from_input).
+std::vector<std::string> region_names(const ParameterList& input) {
   const ParameterList& d = input.sublist("Discretization");
   std::vector<std::string> names;
   const ParameterList& regions = d.sublist("Regions");
   for (auto it = regions.begin(); it != regions.end(); ++it)
     names.push_back(regions.name(it));
   const int dim = d.get<int>("Dimension");
-  // Same order as grid_from_input appends the layer regions.
   const auto faces = d.get<Array<std::string>>("Boundary Layers");
   for (int k = 0; k < dim; ++k)
     for (int side = 0; side < 2; ++side) {
@@ -612,6 +741,20 @@ std::vector<InitialCondition> initial_conditions_from_input(const ParameterList&
           break;
         }
     }
+  return names;
+}
+
+std::uint32_t region_mask(const std::vector<std::string>& names, const std::string& region) {
+  for (std::size_t r = 0; r < names.size(); ++r)
+    if (names[r] == region)
+      return 1u << r;
+  return 0;  // All
+}
+
+}  // namespace
+
+std::vector<InitialCondition> initial_conditions_from_input(const ParameterList& input) {
+  const auto names = region_names(input);
   std::vector<InitialCondition> out;
   const ParameterList& ics = input.sublist("Initial Conditions");
   for (auto it = ics.begin(); it != ics.end(); ++it) {
@@ -619,13 +762,45 @@ std::vector<InitialCondition> initial_conditions_from_input(const ParameterList&
     InitialCondition ic;
     ic.name = ics.name(it);
     ic.field = c.get<std::string>("Field");
-    const std::string region = c.get<std::string>("Region");
-    for (std::size_t r = 0; r < names.size(); ++r)
-      if (names[r] == region)
-        ic.region_mask = 1u << r;
+    ic.region_mask = region_mask(names, c.get<std::string>("Region"));
     const auto v = c.get<Array<double>>("Value");
     ic.value.assign(v.begin(), v.end());
     out.push_back(ic);
+  }
+  return out;
+}
+
+std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterList& input) {
+  const auto names = region_names(input);
+  const int dim = input_dimension(input);
+  std::vector<BoundaryCondition> out;
+  const ParameterList& bcs = input.sublist("Boundary Conditions");
+  for (auto it = bcs.begin(); it != bcs.end(); ++it) {
+    const ParameterList& c = bcs.sublist(bcs.name(it));
+    BoundaryCondition bc;
+    bc.name = bcs.name(it);
+    const std::string type = c.get<std::string>("Type");
+    bc.kind = type == "Displacement"     ? BoundaryCondition::Displacement
+              : type == "Velocity"       ? BoundaryCondition::Velocity
+              : type == "Micro-Rotation" ? BoundaryCondition::MicroRotation
+              : type == "Traction"       ? BoundaryCondition::Traction
+                                         : BoundaryCondition::BodyForce;
+    bc.region_mask = region_mask(names, c.get<std::string>("Region"));
+    bc.component = c.get<std::string>("Component")[0] - 'x';
+    // In 2D the only rotation component, about z, is theta's component 0.
+    if (bc.kind == BoundaryCondition::MicroRotation && dim == 2)
+      bc.component = 0;
+    bc.value = c.get<double>("Value");
+    const std::string tf = c.get<std::string>("Time Function");
+    bc.time.kind = tf == "Constant" ? TimeFunction::Constant
+                   : tf == "Ramp"   ? TimeFunction::Ramp
+                   : tf == "Rate"   ? TimeFunction::Rate
+                                    : TimeFunction::Table;
+    bc.time.ramp_time = c.get<double>("Ramp Time");
+    const auto t = c.get<Array<double>>("Times"), v = c.get<Array<double>>("Values");
+    bc.time.times.assign(t.begin(), t.end());
+    bc.time.values.assign(v.begin(), v.end());
+    out.push_back(bc);
   }
   return out;
 }

@@ -12,6 +12,7 @@
 
 #include "mupm/csv.hpp"
 #include "mupm/hdf5_io.hpp"
+#include "mupm/solid_solver.hpp"
 #include "mupm/timers.hpp"
 #include "mupm/xdmf.hpp"
 
@@ -170,7 +171,8 @@ BondTable<Dim> bond_table(const Discretization<Dim>& disc, MPI_Comm comm) {
 
 template <int Dim>
 void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, long long step,
-                      double time, const std::vector<double>& output_history) {
+                      double time, const std::vector<double>& output_history,
+                      const std::vector<double>& solver_globals) {
   ScopedRegion region("mupm::Output::checkpoint");
   const MPI_Comm comm = raw(*disc.dist.comm());
   const std::size_t n = disc.points.n_owned;
@@ -187,6 +189,7 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
     file.write_attribute("spacing", disc.grid.dx);
     file.write_attribute("horizon", disc.grid.horizon);
     file.write_global("output_history", output_history);
+    file.write_global("solver_globals", solver_globals);
     for (const auto& f : state_fields(disc.points)) {
       const auto rows = owned_rows(f.view, n);
       file.write_points("points/" + f.name, gids, n_global, int(f.view.extent(1)), rows.data());
@@ -211,7 +214,8 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
 
 template <int Dim>
 void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long long& step,
-                     double& time, std::vector<double>& output_history) {
+                     double& time, std::vector<double>& output_history,
+                     std::vector<double>* solver_globals) {
   ScopedRegion region("mupm::Output::restart");
   const MPI_Comm comm = raw(*disc.dist.comm());
   const std::size_t n = disc.points.n_owned;
@@ -237,6 +241,8 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
   step = file.read_attribute_int("step");
   time = file.read_attribute_double("time");
   output_history = file.read_global("output_history");
+  if (solver_globals)
+    *solver_globals = file.read_global("solver_globals");
   for (const auto& f : state_fields(disc.points)) {
     std::vector<double> rows(n * f.view.extent(1));
     file.read_points("points/" + f.name, gids, int(f.view.extent(1)), rows.data());
@@ -395,6 +401,27 @@ GlobalId non_finite_point(const Points<Dim>& p) {
   return g;
 }
 
+// The kinematics-only model: central difference (eqs 127-136) with zero force,
+// v(n+1/2) = v(n) + dt/2 a(n), u(n+1) = u(n) + dt v(n+1/2), a(n+1) = 0, v(n+1) = v(n+1/2).
+template <int Dim>
+void kinematic_step(const Points<Dim>& pts, double dt) {
+  auto u = pts.u, v = pts.v, a = pts.a;
+  auto th = pts.theta, om = pts.omega, al = pts.alpha;
+  Kokkos::parallel_for(
+      "mupm::Solver::integrate", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        for (int k = 0; k < Dim; ++k) {
+          u(i, k) += dt * (v(i, k) + 0.5 * dt * a(i, k));
+          v(i, k) += 0.5 * dt * a(i, k);
+          a(i, k) = 0.0;
+        }
+        for (int k = 0; k < kRotDim<Dim>; ++k) {
+          th(i, k) += dt * (om(i, k) + 0.5 * dt * al(i, k));
+          om(i, k) += 0.5 * dt * al(i, k);
+          al(i, k) = 0.0;
+        }
+      });
+}
+
 template <int Dim>
 RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::ParameterList& input,
                std::ostream& out) {
@@ -448,13 +475,16 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
         << " bytes per point, " << disc.bonds.bytes_per_bond() << " bytes per bond\n";
   }
 
+  const auto& materials = input.sublist("Materials");
+  Kokkos::deep_copy(pts.porosity, materials.get<double>("Porosity"));
+  Kokkos::deep_copy(pts.saturation, 1.0);  // saturated unless an initial condition says otherwise
   apply_initial_conditions(initial_conditions_from_input(input), pts);
   long long step = 0;
   double time = 0;
-  std::vector<double> history;
+  std::vector<double> history, solver_globals;
   const std::string restart = solver.get<std::string>("Restart From");
   if (!restart.empty()) {
-    read_checkpoint(restart, disc, step, time, history);
+    read_checkpoint(restart, disc, step, time, history, &solver_globals);
     if (rank == 0)
       out << "mupm: restarted from " << restart << " at step " << step << "\n";
   }
@@ -465,7 +495,49 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   }();
   disc.dist.refresh(ghosted);
 
-  const double dt = solver.get<double>("Time Step");
+  // The physics. Solid: the micropolar solid step; otherwise kinematics only.
+  const bool solid = solver.get<std::string>("Physics") == "Micropolar Solid";
+  std::unique_ptr<SolidSolver<Dim>> solid_solver;
+  double dt = solver.get<double>("Time Step");
+  if (solid) {
+    SolidParams prm;
+    prm.law = MicropolarElastic::from_bulk_shear(
+        materials.get<double>("Bulk Modulus"), materials.get<double>("Shear Modulus"),
+        materials.get<double>("Micropolar Shear Modulus"), materials.get<double>("Length Scale"));
+    prm.stabilization = materials.get<double>("Stabilization");
+    const std::string sm = materials.get<std::string>("Stabilization Modulus");
+    prm.stab_modulus =
+        stabilization_modulus<Dim>(prm.law, grid.horizon, grid.thickness,
+                                   sm == "Eq 71"           ? StabilizationModulus::Eq71
+                                   : sm == "Bulk Matching" ? StabilizationModulus::BulkMatching
+                                                           : StabilizationModulus::Automatic);
+    prm.horizon_volume = Dim == 2 ? kPi * grid.horizon * grid.horizon * grid.thickness
+                                  : 4.0 / 3.0 * kPi * std::pow(grid.horizon, 3);
+    typename SolidSolver<Dim>::Settings settings;
+    settings.rho_s = materials.get<double>("Solid Density");
+    settings.rho_w = input.sublist("Fluid").get<double>("Water Density");
+    const auto g = solver.get<Teuchos::Array<double>>("Gravity");
+    for (Teuchos::Ordinal k = 0; k < g.size(); ++k)
+      settings.gravity[k] = g[k];
+    settings.damping = solver.get<double>("Damping");
+    solid_solver = std::make_unique<SolidSolver<Dim>>(
+        disc, prm, boundary_conditions_from_input(input), settings, mpi);
+    solid_solver->set_globals(solver_globals);
+    solid_solver->initialize(time, !restart.empty());
+    const double stable = solid_solver->estimate_stable_dt();
+    const double safety = solver.get<double>("Time Step Safety Factor");
+    if (solver.get<bool>("Automatic Time Step"))
+      dt = safety * stable;
+    if (rank == 0) {
+      out << "mupm: micropolar solid, stabilization G = " << prm.stabilization
+          << ", D = " << prm.stab_modulus << " Pa/m^2; estimated stable dt = " << stable
+          << " s; dt = " << dt << " s\n";
+      if (dt > safety * stable)
+        out << "mupm: WARNING: Solver->Time Step = " << dt << " s exceeds "
+            << "Time Step Safety Factor x the estimated stable step = " << safety * stable
+            << " s: the run may blow up. Use a smaller Time Step or Automatic Time Step.\n";
+    }
+  }
   const long long n_steps = solver.get<int>("Number of Steps");
   const long long first_step = step, last_step = n_steps;
   const int field_interval = output.get<int>("Field Interval");
@@ -476,12 +548,31 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   const auto field_names = output.get<Teuchos::Array<std::string>>("Fields");
   FieldOutput<Dim> fields(folder, disc, {field_names.begin(), field_names.end()}, history);
   std::unique_ptr<io::CsvWriter> csv;
+  std::vector<std::string> columns{"step", "time", "max_displacement", "mean_damage",
+                                   "broken_bonds"};
+  if (solid) {
+    for (const char* c :
+         {"internal_energy", "kinetic_energy", "external_work", "dissipation", "energy_error"})
+      columns.push_back(c);
+    for (const auto& r : solid_solver->reaction_names())
+      columns.push_back(r);
+  }
+  columns.push_back("wall_seconds");
   if (rank == 0)
-    csv = std::make_unique<io::CsvWriter>(
-        folder + "/time_series.csv",
-        std::vector<std::string>{"step", "time", "max_displacement", "mean_damage", "broken_bonds",
-                                 "wall_seconds"},
-        !restart.empty());
+    csv = std::make_unique<io::CsvWriter>(folder + "/time_series.csv", columns, !restart.empty());
+  // Energy balance (eqs 137-140): E_int + E_kin + D - W_ext stays at its initial value.
+  double energy0 = solid ? solid_solver->energy().balance() : 0.0;
+  if (solid && solver_globals.size() == 3)
+    energy0 = solver_globals[2];
+  const double energy_tol = solver.get<double>("Energy Tolerance");
+  const bool energy_stop = solver.get<bool>("Stop On Energy Violation");
+  long long energy_warnings = 0;
+  auto solver_state = [&] {
+    auto g = solid ? solid_solver->globals() : std::vector<double>{};
+    if (solid)
+      g.push_back(energy0);
+    return g;
+  };
 
   auto write_series = [&] {
     ScopedRegion region("mupm::Output::time_series");
@@ -510,10 +601,20 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     MPI_Allreduce(MPI_IN_PLACE, &umax2, 1, MPI_DOUBLE, MPI_MAX, mpi);
     MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, mpi);
     MPI_Allreduce(MPI_IN_PLACE, &broken, 1, MPI_LONG_LONG, MPI_SUM, mpi);
+    std::vector<double> row{double(step), time, std::sqrt(umax2),
+                            sums[1] > 0 ? sums[0] / sums[1] : 0.0,
+                            double(broken) / 2};  // each bond is listed by both its ends
+    if (solid) {
+      const auto e = solid_solver->energy();
+      for (double v :
+           {e.internal, e.kinetic, e.external_work, e.dissipation, e.balance() - energy0})
+        row.push_back(v);
+      for (double r : solid_solver->reactions())
+        row.push_back(r);
+    }
+    row.push_back(std::chrono::duration<double>(Clock::now() - t_start).count());
     if (csv)
-      csv->row({double(step), time, std::sqrt(umax2), sums[1] > 0 ? sums[0] / sums[1] : 0.0,
-                double(broken) / 2,  // each bond is listed by both its ends
-                std::chrono::duration<double>(Clock::now() - t_start).count()});
+      csv->row(row);
   };
 
   if (restart.empty())
@@ -527,31 +628,32 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   while (step < last_step) {
     {
       ScopedRegion region("mupm::Solver::step");
-      // Central difference (eqs 127-136) with zero force in the kinematics-only model:
-      // v(n+1/2) = v(n) + dt/2 a(n), u(n+1) = u(n) + dt v(n+1/2), then a(n+1) from the forces
-      // (none yet) and v(n+1) = v(n+1/2) + dt/2 a(n+1). The same for theta.
-      auto u = pts.u, v = pts.v, a = pts.a;
-      auto th = pts.theta, om = pts.omega, al = pts.alpha;
-      Kokkos::parallel_for(
-          "mupm::Solver::integrate", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-            for (int k = 0; k < Dim; ++k) {
-              const double vh = v(i, k) + 0.5 * dt * a(i, k);
-              u(i, k) += dt * vh;
-              a(i, k) = 0.0;
-              v(i, k) = vh + 0.5 * dt * a(i, k);
-            }
-            for (int k = 0; k < kRotDim<Dim>; ++k) {
-              const double wh = om(i, k) + 0.5 * dt * al(i, k);
-              th(i, k) += dt * wh;
-              al(i, k) = 0.0;
-              om(i, k) = wh + 0.5 * dt * al(i, k);
-            }
-          });
-      compute_damage(disc.bonds, pts);
-      disc.dist.refresh(ghosted);
+      if (solid) {
+        solid_solver->step(time, dt);
+        compute_damage(disc.bonds, pts);
+      } else {
+        kinematic_step(pts, dt);
+        compute_damage(disc.bonds, pts);
+        disc.dist.refresh(ghosted);
+      }
     }
     ++step;
-    time = double(step) * dt;
+    time += dt;
+    if (solid) {
+      const auto e = solid_solver->energy();
+      const double err = std::abs(e.balance() - energy0);
+      if (err > energy_tol * e.scale() && e.scale() > 0) {
+        std::ostringstream s;
+        s << "energy balance violated at step " << step << " (t = " << time
+          << " s): |E_int + E_kin + D - W_ext - E_0| = " << err << " J is " << err / e.scale()
+          << " of the largest term (Solver->Energy Tolerance = " << energy_tol << ")";
+        if (energy_stop)
+          throw CollectiveError("Error, " + s.str() + ".");
+        if (rank == 0 && (energy_warnings < 5 || energy_warnings % 1000 == 0))
+          out << "mupm: WARNING: " << s.str() << "\n";
+        ++energy_warnings;
+      }
+    }
     if (check_finite) {
       GlobalId bad = non_finite_point(pts);
       MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_LONG_LONG, MPI_MAX, mpi);
@@ -578,7 +680,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     if ((field_interval > 0 && step % field_interval == 0) || step == last_step)
       fields.write(step, time);
     if (checkpoint_interval > 0 && step % checkpoint_interval == 0 && step != last_step)
-      write_checkpoint(checkpoint_path, disc, step, time, fields.history());
+      write_checkpoint(checkpoint_path, disc, step, time, fields.history(), solver_state());
     const auto now = Clock::now();
     if (rank == 0 &&
         (std::chrono::duration<double>(now - t_last_progress).count() >= progress_interval ||
@@ -597,7 +699,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     }
   }
   if (output.get<bool>("Checkpoint At End"))
-    write_checkpoint(checkpoint_path, disc, step, time, fields.history());
+    write_checkpoint(checkpoint_path, disc, step, time, fields.history(), solver_state());
 
   RunSummary summary;
   summary.steps = step - first_step;
@@ -632,9 +734,10 @@ RunSummary run_simulation(const Teuchos::RCP<const Teuchos::Comm<int>>& comm,
   template void apply_initial_conditions<D>(const std::vector<InitialCondition>&, Points<D>&);  \
   template void compute_damage<D>(const Bonds&, Points<D>&);                                    \
   template void write_checkpoint<D>(const std::string&, const Discretization<D>&, long long,    \
-                                    double, const std::vector<double>&);                        \
+                                    double, const std::vector<double>&,                         \
+                                    const std::vector<double>&);                                \
   template void read_checkpoint<D>(const std::string&, Discretization<D>&, long long&, double&, \
-                                   std::vector<double>&);
+                                   std::vector<double>&, std::vector<double>*);
 MUPM_INSTANTIATE(2)
 MUPM_INSTANTIATE(3)
 #undef MUPM_INSTANTIATE

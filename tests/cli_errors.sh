@@ -11,6 +11,11 @@ base() {  # base DISCRETIZATION_EXTRA SOLVER_EXTRA
     <Parameter name="Counts" type="Array(int)" value="{20, 10}"/>
     $1
   </ParameterList>
+  <ParameterList name="Materials">
+    <Parameter name="Bulk Modulus" type="double" value="1e8"/>
+    <Parameter name="Shear Modulus" type="double" value="5e7"/>
+    <Parameter name="Length Scale" type="double" value="1e-3"/>
+  </ParameterList>
   <ParameterList name="Solver">
     <Parameter name="Number of Steps" type="int" value="2"/>
     $2

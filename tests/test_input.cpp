@@ -9,9 +9,19 @@
 namespace mupm {
 namespace {
 
+// An input with the given Discretization entries and other sublists; a solid's required
+// material constants are added unless `rest` has a Materials sublist.
 std::string xml(const std::string& discretization, const std::string& rest = "") {
+  const std::string materials =
+      rest.find("name=\"Materials\"") != std::string::npos
+          ? ""
+          : "<ParameterList name=\"Materials\">"
+            "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+            "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+            "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+            "</ParameterList>";
   return "<ParameterList name=\"mupm\"><ParameterList name=\"Discretization\">" + discretization +
-         "</ParameterList>" + rest + "</ParameterList>";
+         "</ParameterList>" + materials + rest + "</ParameterList>";
 }
 const std::string kOk =
     "<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
@@ -57,8 +67,8 @@ TEST(Input, ExtentsLayersRegions) {
   const auto g = grid_from_input<2>(*pl);
   EXPECT_EQ(g.counts[0], 20);
   EXPECT_EQ(g.counts[1], 10);
-  EXPECT_EQ(g.layers[1][0], 4);  // floor(0.04 / 0.01)
-  EXPECT_EQ(g.layers[1][1], 4);
+  EXPECT_EQ(g.layers[1][0], 8);  // floor(2 horizons: 2 x 0.04 / 0.01)
+  EXPECT_EQ(g.layers[1][1], 8);
   EXPECT_EQ(g.layers[0][0], 0);
   ASSERT_EQ(g.region_names.size(), 3u);
   EXPECT_EQ(g.region_names[0], "top");
@@ -151,6 +161,49 @@ TEST(Input, NumbersAreReadStrictly) {
                {"mupm->Solver->Number of Steps", "not a finite int"});
   expect_error(xml(kOk + "<Parameter name=\"Horizon\" type=\"double\" value=\"nan\"/>"),
                {"mupm->Discretization->Horizon", "nan"});
+}
+
+TEST(Input, SolidAndBoundaryConditions) {
+  // A solid needs its moduli and length scale.
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Materials\"><Parameter name=\"Bulk Modulus\" "
+                   "type=\"double\" value=\"1e8\"/></ParameterList>"),
+               {"mupm->Materials->Shear Modulus", "> 0"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"b\">"
+                   "<Parameter name=\"Type\" type=\"string\" value=\"Micro-Rotation\"/>"
+                   "<Parameter name=\"Component\" type=\"string\" value=\"x\"/>"
+                   "</ParameterList></ParameterList>"),
+               {"mupm->Boundary Conditions->b->Component", "about z"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"b\">"
+                   "<Parameter name=\"Time Function\" type=\"string\" value=\"Table\"/>"
+                   "<Parameter name=\"Times\" type=\"Array(double)\" value=\"{0, 1}\"/>"
+                   "</ParameterList></ParameterList>"),
+               {"mupm->Boundary Conditions->b", "Table"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"b\">"
+                   "<Parameter name=\"Type\" type=\"string\" value=\"Pressure\"/>"
+                   "</ParameterList></ParameterList>"),
+               {"Type", "mupm->Boundary Conditions->b", "Pressure"});
+  auto pl =
+      parse_input(xml(kOk,
+                      "<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"pull\">"
+                      "<Parameter name=\"Component\" type=\"string\" value=\"y\"/>"
+                      "<Parameter name=\"Value\" type=\"double\" value=\"2\"/>"
+                      "<Parameter name=\"Time Function\" type=\"string\" value=\"Table\"/>"
+                      "<Parameter name=\"Times\" type=\"Array(double)\" value=\"{0, 1, 3}\"/>"
+                      "<Parameter name=\"Values\" type=\"Array(double)\" value=\"{0, 1, 0}\"/>"
+                      "</ParameterList></ParameterList>"));
+  validate_input(*pl);
+  const auto bcs = boundary_conditions_from_input(*pl);
+  ASSERT_EQ(bcs.size(), 1u);
+  EXPECT_EQ(bcs[0].component, 1);
+  EXPECT_EQ(bcs[0].kind, BoundaryCondition::Displacement);
+  EXPECT_DOUBLE_EQ(bcs[0].time(0.5), 0.5);  // piecewise-linear table
+  EXPECT_DOUBLE_EQ(bcs[0].time(2.0), 0.5);
+  EXPECT_DOUBLE_EQ(bcs[0].time(5.0), 0.0);  // held after the table
+  EXPECT_DOUBLE_EQ(bcs[0].time.rate(2.0), -0.5);
 }
 
 TEST(Input, MalformedXml) {

@@ -188,6 +188,7 @@ void checkerboard(const MicropolarElastic& law) {
         ASSERT_LT(f(i, 0) * u(i, 0), -1e-3 * fscale * c);  // restoring, of the scale mu c/dx^2
       }
     }
+    MPI_Allreduce(MPI_IN_PLACE, &e_in, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
     if (G == 0) {
       EXPECT_NEAR(e_in, 0.0, 1e-25);
     } else {

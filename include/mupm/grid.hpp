@@ -26,8 +26,8 @@ struct GridSpec {
   std::vector<std::string> region_names;
   std::vector<Box> regions;
 
-  // Rows of boundary layer needed so that every real point has a full family: floor(delta/dx).
-  int layer_rows() const { return static_cast<int>(horizon / dx * (1 + 1e-10)); }
+  // Lattice rows within the horizon: floor(delta/dx).
+  int horizon_cells() const { return static_cast<int>(horizon / dx * (1 + 1e-10)); }
   long long lattice_count(int d) const { return counts[d] + layers[d][0] + layers[d][1]; }
   long long n_global() const {
     long long n = 1;
@@ -132,7 +132,7 @@ std::vector<GlobalId> ghost_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& 
   std::vector<GlobalId> out;
   if (b.size() == 0)
     return out;
-  const long long m = g.layer_rows();
+  const long long m = g.horizon_cells();
   LatticeBox<Dim> wide;
   long long n[Dim];
   for (int d = 0; d < Dim; ++d) {

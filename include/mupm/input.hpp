@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "mupm/boundary_conditions.hpp"
 #include "mupm/error.hpp"
 #include "mupm/grid.hpp"
 
@@ -46,6 +47,8 @@ struct InitialCondition {
   std::vector<double> value;
 };
 std::vector<InitialCondition> initial_conditions_from_input(const Teuchos::ParameterList& input);
+
+std::vector<BoundaryCondition> boundary_conditions_from_input(const Teuchos::ParameterList& input);
 
 // Names of the point fields that can be written (Output->Fields).
 const std::vector<std::string>& output_field_names();

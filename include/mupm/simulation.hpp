@@ -35,12 +35,14 @@ void compute_damage(const Bonds& bonds, Points<Dim>& p);
 // Collective checkpoint of points and bonds keyed by global id.
 template <int Dim>
 void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, long long step,
-                      double time, const std::vector<double>& output_history);
+                      double time, const std::vector<double>& output_history,
+                      const std::vector<double>& solver_globals = {});
 // Collective restore; returns the step and time stored and fills output_history. Throws
 // std::runtime_error (on every rank) when the checkpoint does not match the discretization.
 template <int Dim>
 void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long long& step,
-                     double& time, std::vector<double>& output_history);
+                     double& time, std::vector<double>& output_history,
+                     std::vector<double>* solver_globals = nullptr);
 
 struct RunSummary {
   long long steps = 0;

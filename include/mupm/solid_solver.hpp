@@ -1,0 +1,321 @@
+// The solid step of Algorithm 1 for the elastic micropolar solid: boundary conditions, forces,
+// central difference, energy bookkeeping (eqs 137-140), reactions, stable-step estimate.
+#ifndef MUPM_SOLID_SOLVER_HPP
+#define MUPM_SOLID_SOLVER_HPP
+
+#include <mpi.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mupm/boundary_conditions.hpp"
+#include "mupm/central_difference.hpp"
+#include "mupm/discretization.hpp"
+#include "mupm/solid.hpp"
+
+namespace mupm {
+
+template <int Dim>
+class SolidSolver {
+ public:
+  static constexpr int R = kRotDim<Dim>;
+
+  struct Settings {
+    double rho_s = 2000, rho_w = 1000;
+    Kokkos::Array<double, 3> gravity{};
+    double damping = 0;
+  };
+  struct Energy {
+    double internal = 0, kinetic = 0, external_work = 0, dissipation = 0;
+    // E_int + E_kin + D - W_ext, which the scheme keeps constant (eq 140).
+    double balance() const { return internal + kinetic + dissipation - external_work; }
+    double scale() const {
+      return std::max(std::max(std::abs(internal), kinetic),
+                      std::max(std::abs(external_work), dissipation));
+    }
+  };
+
+  SolidSolver(Discretization<Dim>& disc, const SolidParams& prm, std::vector<BoundaryCondition> bcs,
+              const Settings& settings, MPI_Comm comm)
+      : disc_(disc), prm_(prm), bcs_(std::move(bcs)), set_(settings), comm_(comm) {
+    auto& p = disc_.points;
+    st_.allocate(p.size(), p.n_owned);
+    rho_ = Scalars("mupm::density", p.n_owned);
+    inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
+    body_ = Vectors("mupm::body_force", p.n_owned, Dim);
+    du_ = Vectors("mupm::step_increment", p.n_owned, Dim + R);
+  }
+
+  const SolidState<Dim>& state() const { return st_; }
+  const Scalars& density() const { return rho_; }
+  // Work of the boundary and body forces and damping dissipation since t = 0 (for restarts).
+  std::vector<double> globals() const { return {work_, dissipation_}; }
+  void set_globals(const std::vector<double>& g) {
+    if (g.size() >= 2) {  // (the driver appends its own entries after these)
+      work_ = g[0];
+      dissipation_ = g[1];
+    }
+  }
+
+  // Marks prescribed components, computes densities (eqs 1, 13) from porosity and saturation,
+  // and the forces of the current state; at a start (not a restart, whose state holds them)
+  // also the boundary values at t and the accelerations.
+  void initialize(double t, bool restarted) {
+    auto& p = disc_.points;
+    mark_fixed(bcs_, p);
+    auto phi = p.porosity, sr = p.saturation;
+    auto rho = rho_, J = inertia_;
+    const double rho_s = set_.rho_s, rho_w = set_.rho_w, l = prm_.law.length;
+    Kokkos::parallel_for(
+        "mupm::Solid::density", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          rho(i) = mixture_density(phi(i), rho_s, sr(i), rho_w);
+          J(i) = micro_inertia(phi(i), rho_s, l);
+        });
+    if (!restarted)
+      apply_kinematic(bcs_, p, t, 0.0);
+    disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
+    forces(t);
+    if (!restarted)
+      advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, set_.gravity, 0.0, 0.0);
+  }
+
+  // One step from t to t + dt.
+  void step(double t, double dt) {
+    ScopedRegion region("mupm::Solid::step");
+    auto& p = disc_.points;
+    save_positions();
+    advance_positions(p, dt);
+    apply_kinematic(bcs_, p, t, dt);
+    increments();
+    work_ += 0.5 * power();  // old forces on the increment (trapezoid, first half)
+    forces(t + dt);
+    work_ += 0.5 * power();  // new forces (second half)
+    dissipation_ += dt * damping_power();
+    advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, set_.gravity, set_.damping,
+                       dt);
+  }
+
+  Energy energy() const {
+    const auto& p = disc_.points;
+    auto en = st_.energy;
+    auto v = p.v, om = p.omega;
+    auto vol = p.volume;
+    auto fixed = p.fixed;
+    auto rho = rho_, J = inertia_;
+    double e[2] = {0, 0};
+    Kokkos::parallel_reduce(
+        "mupm::Solid::energy", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& ei, double& ek) {
+          ei += en(i);
+          const std::uint32_t fx = fixed(i);
+          for (int k = 0; k < Dim; ++k)
+            if (!(fx & (1u << k)))
+              ek += 0.5 * rho(i) * vol(i) * v(i, k) * v(i, k);
+          for (int r = 0; r < R; ++r)
+            if (!(fx & (1u << (Dim + r))))
+              ek += 0.5 * J(i) * vol(i) * om(i, r) * om(i, r);
+        },
+        e[0], e[1]);
+    MPI_Allreduce(MPI_IN_PLACE, e, 2, MPI_DOUBLE, MPI_SUM, comm_);
+    return {e[0], e[1], work_, dissipation_};
+  }
+
+  // Force (moment) the boundary applies on each kinematic condition's points: -sum f V.
+  std::vector<std::string> reaction_names() const {
+    std::vector<std::string> n;
+    for (const auto& bc : bcs_)
+      if (bc.kinematic())
+        n.push_back("reaction_" + bc.name);
+    return n;
+  }
+  std::vector<double> reactions() const {
+    std::vector<double> out;
+    const auto& p = disc_.points;
+    for (const auto& bc : bcs_) {
+      if (!bc.kinematic())
+        continue;
+      const bool rot = bc.kind == BoundaryCondition::MicroRotation;
+      const Vectors f = rot ? st_.moment : st_.force;
+      const int c = bc.component;
+      const std::uint32_t mask = bc.region_mask;
+      auto regions = p.regions;
+      auto vol = p.volume;
+      double s = 0;
+      Kokkos::parallel_reduce(
+          "mupm::Solid::reaction", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+            if (mask == 0 || (regions(i) & mask))
+              acc -= f(i, c) * vol(i);
+          },
+          s);
+      MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
+      out.push_back(s);
+    }
+    return out;
+  }
+
+  // Largest stable step of the undamped central difference, 2 / omega_max, with omega_max^2
+  // the largest eigenvalue of M^-1 K of the discrete operator (prescribed components held),
+  // by power iteration with the mass-weighted Rayleigh quotient (it approaches omega_max^2
+  // from below). The state is restored afterwards.
+  double estimate_stable_dt(int iterations = 40) {
+    ScopedRegion region("mupm::Solid::stable_step");
+    auto& p = disc_.points;
+    const std::size_t n = p.size();
+    Vectors u0("u0", n, Dim), t0("t0", n, R);
+    Kokkos::deep_copy(u0, p.u);
+    Kokkos::deep_copy(t0, p.theta);
+    Scalars p0("p0", n);
+    Kokkos::deep_copy(p0, p.p);
+    Kokkos::deep_copy(p.p, 0.0);  // the operator's linear part only
+    auto u = p.u, th = p.theta, gid = p.gid;
+    auto fixed = p.fixed;
+    Kokkos::parallel_for(
+        "mupm::Solid::stable_step_start", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          const double s = double(gid(i));
+          for (int k = 0; k < Dim; ++k)
+            u(i, k) = (fixed(i) & (1u << k)) ? 0.0 : std::sin(1.3 * s + 0.7 * k) + 0.1;
+          for (int r = 0; r < R; ++r)
+            th(i, r) = (fixed(i) & (1u << (Dim + r))) ? 0.0 : std::cos(0.9 * s + 0.3 * r);
+        });
+    double lambda = 0;
+    for (int it = 0; it < iterations; ++it) {
+      disc_.dist.refresh({p.u, p.theta});
+      solid_forces(p, disc_.bonds, prm_, st_, disc_.dist);
+      auto f = st_.force, l = st_.moment, vol = p.volume;
+      auto rho = rho_, J = inertia_;
+      double s[3] = {0, 0, 0};  // x.Kx, x.Mx, |M^-1 K x|_M^2
+      Kokkos::parallel_reduce(
+          "mupm::Solid::stable_step_rayleigh", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& kx, double& mx, double& yy) {
+            for (int k = 0; k < Dim; ++k) {
+              if (fixed(i) & (1u << k))
+                continue;
+              kx -= f(i, k) * u(i, k) * vol(i);
+              mx += rho(i) * u(i, k) * u(i, k) * vol(i);
+              yy += f(i, k) * f(i, k) / rho(i) * vol(i);
+            }
+            for (int r = 0; r < R; ++r) {
+              if (fixed(i) & (1u << (Dim + r)))
+                continue;
+              kx -= l(i, r) * th(i, r) * vol(i);
+              mx += J(i) * th(i, r) * th(i, r) * vol(i);
+              yy += l(i, r) * l(i, r) / J(i) * vol(i);
+            }
+          },
+          s[0], s[1], s[2]);
+      MPI_Allreduce(MPI_IN_PLACE, s, 3, MPI_DOUBLE, MPI_SUM, comm_);
+      lambda = s[1] > 0 ? s[0] / s[1] : 0.0;
+      const double norm = s[2] > 0 ? 1.0 / std::sqrt(s[2]) : 0.0;
+      Kokkos::parallel_for(
+          "mupm::Solid::stable_step_next", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            for (int k = 0; k < Dim; ++k)
+              u(i, k) = (fixed(i) & (1u << k)) ? 0.0 : -f(i, k) / rho(i) * norm;
+            for (int r = 0; r < R; ++r)
+              th(i, r) = (fixed(i) & (1u << (Dim + r))) ? 0.0 : -l(i, r) / J(i) * norm;
+          });
+    }
+    Kokkos::deep_copy(p.u, u0);
+    Kokkos::deep_copy(p.theta, t0);
+    Kokkos::deep_copy(p.p, p0);
+    disc_.dist.refresh({p.u, p.theta});
+    solid_forces(p, disc_.bonds, prm_, st_, disc_.dist);
+    return lambda > 0 ? 2.0 / std::sqrt(lambda) : 0.0;
+  }
+
+ private:
+  void forces(double t) {
+    auto& p = disc_.points;
+    disc_.dist.refresh({p.u, p.theta});
+    solid_forces(p, disc_.bonds, prm_, st_, disc_.dist);
+    body_force_density(bcs_, p, disc_.grid.dx, t, body_);
+  }
+
+  void save_positions() {
+    auto& p = disc_.points;
+    auto u = p.u, th = p.theta, du = du_;
+    Kokkos::parallel_for(
+        "mupm::Solid::save", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          for (int k = 0; k < Dim; ++k)
+            du(i, k) = u(i, k);
+          for (int r = 0; r < R; ++r)
+            du(i, Dim + r) = th(i, r);
+        });
+  }
+  void increments() {
+    auto& p = disc_.points;
+    auto u = p.u, th = p.theta, du = du_;
+    Kokkos::parallel_for(
+        "mupm::Solid::increment", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          for (int k = 0; k < Dim; ++k)
+            du(i, k) = u(i, k) - du(i, k);
+          for (int r = 0; r < R; ++r)
+            du(i, Dim + r) = th(i, r) - du(i, Dim + r);
+        });
+  }
+  // Power of the external agents on this step's increment: on prescribed components the
+  // boundary holds the point against the body's force density f (it applies -f V); on free
+  // components gravity and the body/traction forces act.
+  double power() const {
+    const auto& p = disc_.points;
+    auto f = st_.force, l = st_.moment, b = body_, du = du_;
+    auto vol = p.volume;
+    auto fixed = p.fixed;
+    auto rho = rho_;
+    const auto g = set_.gravity;
+    double w = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::external_work", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          const std::uint32_t fx = fixed(i);
+          for (int k = 0; k < Dim; ++k)
+            acc += ((fx & (1u << k)) ? -f(i, k) : b(i, k) + rho(i) * g[k]) * du(i, k) * vol(i);
+          for (int r = 0; r < R; ++r)
+            if (fx & (1u << (Dim + r)))
+              acc -= l(i, r) * du(i, Dim + r) * vol(i);
+        },
+        w);
+    MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return w;
+  }
+  // Damping power c (rho v.v + J omega.omega) V at the half step.
+  double damping_power() const {
+    if (set_.damping == 0)
+      return 0.0;
+    const auto& p = disc_.points;
+    auto v = p.v, om = p.omega, vol = p.volume;
+    auto fixed = p.fixed;
+    auto rho = rho_, J = inertia_;
+    const double c = set_.damping;
+    double w = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::damping_power", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          const std::uint32_t fx = fixed(i);
+          for (int k = 0; k < Dim; ++k)
+            if (!(fx & (1u << k)))
+              acc += c * rho(i) * v(i, k) * v(i, k) * vol(i);
+          for (int r = 0; r < R; ++r)
+            if (!(fx & (1u << (Dim + r))))
+              acc += c * J(i) * om(i, r) * om(i, r) * vol(i);
+        },
+        w);
+    MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return w;
+  }
+
+  Discretization<Dim>& disc_;
+  SolidParams prm_;
+  std::vector<BoundaryCondition> bcs_;
+  Settings set_;
+  MPI_Comm comm_;
+  SolidState<Dim> st_;
+  Scalars rho_, inertia_;
+  Vectors body_, du_;
+  double work_ = 0, dissipation_ = 0;
+};
+
+}  // namespace mupm
+
+#endif
