@@ -93,6 +93,28 @@ struct SolidState {
   std::vector<Vectors> pass2_ghosts() const { return {eps, kappa, P1, P2, as_vectors(w0)}; }
 };
 
+// Kinematics of bond i -> j (eqs 2-9): xi = x_j - x_i, the composite relative displacement
+// U^ = (u_j - u_i) - Omega-bar x xi with Omega-bar = (theta_i + theta_j)/2, and the relative
+// rotation Omega = theta_j - theta_i. Returns |xi|^2.
+template <int Dim, class X, class U, class T>
+KOKKOS_INLINE_FUNCTION double bond_kinematics(const X& x, const U& u, const T& th, int i, int j,
+                                              double* xi, double* uh, double* om) {
+  constexpr int R = kRotDim<Dim>;
+  double tb[R], c[Dim], len2 = 0;
+  for (int d = 0; d < Dim; ++d) {
+    xi[d] = x(j, d) - x(i, d);
+    len2 += xi[d] * xi[d];
+  }
+  for (int r = 0; r < R; ++r) {
+    tb[r] = 0.5 * (th(i, r) + th(j, r));
+    om[r] = th(j, r) - th(i, r);
+  }
+  rot_cross<Dim>(tb, xi, c);
+  for (int d = 0; d < Dim; ++d)
+    uh[d] = u(j, d) - u(i, d) - c[d];
+  return len2;
+}
+
 // Pass 1 (per owned point): K, eps, kappa, the constitutive update (sigma-bar, m into
 // pts.stress, pts.couple_stress), Q1, Q2, and the point's energy.
 template <int Dim>
@@ -121,22 +143,16 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
             continue;
           const int j = neighbor(b);
           const double vj = vol(j);
-          double xi[Dim], U[Dim], tb[R], c[Dim];
-          for (int d = 0; d < Dim; ++d) {
-            xi[d] = x(j, d) - x(i, d);
-            U[d] = u(j, d) - u(i, d);
-          }
-          for (int r = 0; r < R; ++r)
-            tb[r] = 0.5 * (th(i, r) + th(j, r));
-          rot_cross<Dim>(tb, xi, c);  // Omega-bar x xi
+          double xi[Dim], uh[Dim], om[R];
+          bond_kinematics<Dim>(x, u, th, int(i), j, xi, uh, om);
           for (int a = 0; a < Dim; ++a)
             for (int k = 0; k < Dim; ++k) {
               K[a * Dim + k] += xi[a] * xi[k] * vj;
-              A[a * Dim + k] += (U[a] - c[a]) * xi[k] * vj;  // U^ (x) xi (eqs 5, 50)
+              A[a * Dim + k] += uh[a] * xi[k] * vj;  // U^ (x) xi (eq 50)
             }
           for (int r = 0; r < R; ++r)
             for (int k = 0; k < Dim; ++k)
-              B[r * Dim + k] += (th(j, r) - th(i, r)) * xi[k] * vj;
+              B[r * Dim + k] += om[r] * xi[k] * vj;  // eq 51
           wsum += vj;
         }
         double tr = 0;
@@ -171,24 +187,16 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
               continue;
             const int j = neighbor(b);
             const double vj = vol(j);
-            double xi[Dim], U[Dim], tb[R], c[Dim], r1[Dim], r2[R], ex[Dim], kx[R];
-            double len2 = 0;
-            for (int d = 0; d < Dim; ++d) {
-              xi[d] = x(j, d) - x(i, d);
-              U[d] = u(j, d) - u(i, d);
-              len2 += xi[d] * xi[d];
-            }
-            for (int r = 0; r < R; ++r)
-              tb[r] = 0.5 * (th(i, r) + th(j, r));
-            rot_cross<Dim>(tb, xi, c);
+            double xi[Dim], uh[Dim], om[R], r1[Dim], r2[R], ex[Dim], kx[R];
+            const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, uh, om);
             mat_vec<Dim, Dim>(eps, xi, ex);
             mat_vec<R, Dim>(kap, xi, kx);
             const double len = std::sqrt(len2);
             const double a1 = c1 / (len2 * len * w0), a2 = c2 / (len * w0);  // eqs 66-70
             for (int d = 0; d < Dim; ++d)
-              r1[d] = U[d] - c[d] - ex[d];  // eq 62
+              r1[d] = uh[d] - ex[d];  // eq 62
             for (int r = 0; r < R; ++r)
-              r2[r] = th(j, r) - th(i, r) - kx[r];  // eq 63
+              r2[r] = om[r] - kx[r];  // eq 63
             for (int a = 0; a < Dim; ++a) {
               ws += 0.5 * a1 * r1[a] * r1[a] * vj;
               for (int k = 0; k < Dim; ++k)
@@ -251,18 +259,8 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
             continue;
           const int j = neighbor(b);
           const double vj = vol(j);
-          double xi[Dim], Uh[Dim], tb[R], c[Dim], Om[R], len2 = 0;
-          for (int d = 0; d < Dim; ++d) {
-            xi[d] = x(j, d) - x(i, d);
-            len2 += xi[d] * xi[d];
-          }
-          for (int r = 0; r < R; ++r) {
-            tb[r] = 0.5 * (th(i, r) + th(j, r));
-            Om[r] = th(j, r) - th(i, r);
-          }
-          rot_cross<Dim>(tb, xi, c);
-          for (int d = 0; d < Dim; ++d)
-            Uh[d] = u(j, d) - u(i, d) - c[d];  // U^_ij (eq 5)
+          double xi[Dim], Uh[Dim], Om[R];
+          const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, Uh, Om);
           const double len = std::sqrt(len2);
           const double a1 = c1 / (len2 * len), a2 = c2 / len;
           const double a1i = w0(i) > 0 ? a1 / w0(i) : 0.0, a2i = w0(i) > 0 ? a2 / w0(i) : 0.0;
