@@ -67,8 +67,10 @@ void bc_template(ParameterList& c) {
         "Displacement [m], Velocity [m/s] or Micro-Rotation [rad] prescribed on the region's "
         "points (the boundary-layer method: use a boundary layer region), or Traction [Pa] "
         "applied as a body force traction/dx on the region's points (make it the outermost real "
-        "row of the face), or Body Force [N/m^3].",
-        one_of({"Displacement", "Velocity", "Micro-Rotation", "Traction", "Body Force"}));
+        "row of the face), or Body Force [N/m^3], or Body Couple [N m/m^3] (Component: the "
+        "rotation axis).",
+        one_of({"Displacement", "Velocity", "Micro-Rotation", "Traction", "Body Force",
+                "Body Couple"}));
   c.set("Region", std::string("All"), "Region name (Discretization->Regions, 'Layer -y', All).");
   c.set("Component", std::string("x"),
         "x, y or z: the displacement/velocity/traction/force component, or the rotation axis "
@@ -471,10 +473,11 @@ void check_dimension_arrays(ParameterList& input) {
     ParameterList& c = bcs.sublist(bcs.name(it));
     check_region(c, regions, faces);
     const std::string type = c.get<std::string>("Type"), comp = c.get<std::string>("Component");
-    if (type == "Micro-Rotation" && dim == 2 && comp != "z")
+    const bool rotation = type == "Micro-Rotation" || type == "Body Couple";
+    if (rotation && dim == 2 && comp != "z")
       throw InputError("Error, " + path_of(c, "Component") + " = " + comp +
                        ": in 2D the micro-rotation is about z; write z.");
-    if (type != "Micro-Rotation" && comp[0] - 'x' >= dim)
+    if (!rotation && comp[0] - 'x' >= dim)
       throw InputError("Error, " + path_of(c, "Component") + " = " + comp + ": a " +
                        std::to_string(dim) + "D body has components x" +
                        (dim == 3 ? ", y and z." : " and y."));
@@ -784,11 +787,13 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterLis
               : type == "Velocity"       ? BoundaryCondition::Velocity
               : type == "Micro-Rotation" ? BoundaryCondition::MicroRotation
               : type == "Traction"       ? BoundaryCondition::Traction
-                                         : BoundaryCondition::BodyForce;
+              : type == "Body Force"     ? BoundaryCondition::BodyForce
+                                         : BoundaryCondition::BodyCouple;
     bc.region_mask = region_mask(names, c.get<std::string>("Region"));
     bc.component = c.get<std::string>("Component")[0] - 'x';
     // In 2D the only rotation component, about z, is theta's component 0.
-    if (bc.kind == BoundaryCondition::MicroRotation && dim == 2)
+    if ((bc.kind == BoundaryCondition::MicroRotation || bc.kind == BoundaryCondition::BodyCouple) &&
+        dim == 2)
       bc.component = 0;
     bc.value = c.get<double>("Value");
     const std::string tf = c.get<std::string>("Time Function");

@@ -261,15 +261,15 @@ FreeRun free_run(double dt, int steps) {
   FreeRun r{};
   double ke;
   body.forces();
-  advance_velocities(pts, body.st.force, body.st.moment, body.rho, body.inertia, none, {0, 0, 0},
-                     0.0, 0.0);  // a(0) from the initial forces (dt = 0: v unchanged)
+  advance_velocities(pts, body.st.force, body.st.moment, body.rho, body.inertia, none, none,
+                     {0, 0, 0}, 0.0, 0.0);  // a(0) from the initial forces (dt = 0: v unchanged)
   momenta(r.p0, r.h0, ke);
   r.e0 = body.energy() + ke;
   for (int n = 0; n < steps; ++n) {
     advance_positions(pts, dt);
     body.forces();
-    advance_velocities(pts, body.st.force, body.st.moment, body.rho, body.inertia, none, {0, 0, 0},
-                       0.0, dt);
+    advance_velocities(pts, body.st.force, body.st.moment, body.rho, body.inertia, none, none,
+                       {0, 0, 0}, 0.0, dt);
     double p[2], h;
     momenta(p, h, ke);
     r.max_energy_error = std::max(r.max_energy_error, std::abs(body.energy() + ke - r.e0));

@@ -20,7 +20,7 @@ void relax(Body<Dim>& body, double dt, double damping, int steps) {
     advance_positions(body.pts(), dt);
     body.forces();
     advance_velocities(body.pts(), body.st.force, body.st.moment, body.rho, body.inertia, none,
-                       {0, 0, 0}, damping, dt);
+                       none, {0, 0, 0}, damping, dt);
   }
 }
 

@@ -62,7 +62,8 @@ struct TimeFunction {
 };
 
 struct BoundaryCondition {
-  enum Kind { Displacement, Velocity, MicroRotation, Traction, BodyForce } kind = Displacement;
+  enum Kind { Displacement, Velocity, MicroRotation, Traction, BodyForce, BodyCouple };
+  Kind kind = Displacement;
   std::string name;
   std::uint32_t region_mask = 0;  // 0: all points
   int component = 0;              // axis (rotation component for MicroRotation)
@@ -140,13 +141,16 @@ void apply_kinematic(const std::vector<BoundaryCondition>& bcs, const Points<Dim
 // Body-force density [N/m^3] at time t: body forces on their regions, and tractions [Pa] spread
 // over the points of their region as traction / dx (the region should be the outermost real
 // row of points of the loaded face, one spacing thick).
+// Body couples [N m/m^3] go to `couple` (component = rotation component).
 template <int Dim>
 void body_force_density(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts,
-                        double dx, double t, const Vectors& body) {
+                        double dx, double t, const Vectors& body, const Vectors& couple) {
   Kokkos::deep_copy(body, 0.0);
+  Kokkos::deep_copy(couple, 0.0);
   for (const auto& bc : bcs) {
     if (bc.kinematic())
       continue;
+    const Vectors target = bc.kind == BoundaryCondition::BodyCouple ? couple : body;
     const std::uint32_t mask = bc.region_mask;
     const int c = bc.component;
     const double b = bc.value * bc.time(t) / (bc.kind == BoundaryCondition::Traction ? dx : 1.0);
@@ -154,7 +158,7 @@ void body_force_density(const std::vector<BoundaryCondition>& bcs, const Points<
     Kokkos::parallel_for(
         "mupm::BC::body_force", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
           if (mask == 0 || (regions(i) & mask))
-            body(i, c) += b;
+            target(i, c) += b;
         });
   }
 }

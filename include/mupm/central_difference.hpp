@@ -36,15 +36,17 @@ void advance_positions(const Points<Dim>& pts, double dt) {
 // Second half, with the new force density f and moment density l:
 // a = f/rho + g - c v(n+1/2), v(n+1) = v(n+1/2) + dt/2 a; alpha = l/J - c omega(n+1/2), likewise.
 // (eq 127: rho a = f + rho g; eq 128: J alpha = l.) body: extra body-force density [n][Dim]
-// (tractions applied on the outermost real layer), may be empty.
+// (tractions applied on the outermost real layer), couple: body-couple density [n][RotDim];
+// either may be empty.
 template <int Dim>
 void advance_velocities(const Points<Dim>& pts, const Vectors& force, const Vectors& moment,
                         const Scalars& rho, const Scalars& inertia, const Vectors& body,
-                        Kokkos::Array<double, 3> gravity, double damping, double dt) {
+                        const Vectors& couple, Kokkos::Array<double, 3> gravity, double damping,
+                        double dt) {
   constexpr int R = kRotDim<Dim>;
   auto v = pts.v, a = pts.a, om = pts.omega, al = pts.alpha;
   auto fixed = pts.fixed;
-  const bool has_body = body.extent(0) > 0;
+  const bool has_body = body.extent(0) > 0, has_couple = couple.extent(0) > 0;
   Kokkos::parallel_for(
       "mupm::Solver::advance_velocities", range(0, pts.n_owned),
       KOKKOS_LAMBDA(const std::size_t i) {
@@ -59,7 +61,8 @@ void advance_velocities(const Points<Dim>& pts, const Vectors& force, const Vect
         for (int r = 0; r < R; ++r) {
           if (fx & (1u << (Dim + r)))
             continue;
-          al(i, r) = moment(i, r) / inertia(i) - damping * om(i, r);
+          const double m = has_couple ? couple(i, r) : 0.0;
+          al(i, r) = (moment(i, r) + m) / inertia(i) - damping * om(i, r);
           om(i, r) += 0.5 * dt * al(i, r);
         }
       });

@@ -44,6 +44,7 @@ class SolidSolver {
     rho_ = Scalars("mupm::density", p.n_owned);
     inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
     body_ = Vectors("mupm::body_force", p.n_owned, Dim);
+    couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", p.n_owned, Dim + R);
   }
 
@@ -77,7 +78,8 @@ class SolidSolver {
     disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
     forces(t);
     if (!restarted)
-      advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, set_.gravity, 0.0, 0.0);
+      advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
+                         0.0, 0.0);
   }
 
   // One step from t to t + dt.
@@ -92,8 +94,8 @@ class SolidSolver {
     forces(t + dt);
     work_ += 0.5 * power();  // new forces (second half)
     dissipation_ += dt * damping_power();
-    advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, set_.gravity, set_.damping,
-                       dt);
+    advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
+                       set_.damping, dt);
   }
 
   Energy energy() const {
@@ -229,7 +231,7 @@ class SolidSolver {
     auto& p = disc_.points;
     disc_.dist.refresh({p.u, p.theta});
     solid_forces(p, disc_.bonds, prm_, st_, disc_.dist);
-    body_force_density(bcs_, p, disc_.grid.dx, t, body_);
+    body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
   }
 
   void save_positions() {
@@ -259,7 +261,7 @@ class SolidSolver {
   // components gravity and the body/traction forces act.
   double power() const {
     const auto& p = disc_.points;
-    auto f = st_.force, l = st_.moment, b = body_, du = du_;
+    auto f = st_.force, l = st_.moment, b = body_, bc = couple_, du = du_;
     auto vol = p.volume;
     auto fixed = p.fixed;
     auto rho = rho_;
@@ -272,8 +274,7 @@ class SolidSolver {
           for (int k = 0; k < Dim; ++k)
             acc += ((fx & (1u << k)) ? -f(i, k) : b(i, k) + rho(i) * g[k]) * du(i, k) * vol(i);
           for (int r = 0; r < R; ++r)
-            if (fx & (1u << (Dim + r)))
-              acc -= l(i, r) * du(i, Dim + r) * vol(i);
+            acc += ((fx & (1u << (Dim + r))) ? -l(i, r) : bc(i, r)) * du(i, Dim + r) * vol(i);
         },
         w);
     MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, comm_);
@@ -312,7 +313,7 @@ class SolidSolver {
   MPI_Comm comm_;
   SolidState<Dim> st_;
   Scalars rho_, inertia_;
-  Vectors body_, du_;
+  Vectors body_, couple_, du_;
   double work_ = 0, dissipation_ = 0;
 };
 
