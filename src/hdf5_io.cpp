@@ -1,5 +1,7 @@
 #include "mupm/hdf5_io.hpp"
 
+#include "mupm/error.hpp"
+
 #include <hdf5.h>
 
 #include <algorithm>
@@ -138,7 +140,7 @@ void agree(MPI_Comm comm, const std::string& local_error) {
   if (!all_failed && size > 1) {
     msg += " [on rank " + std::to_string(first) + "]";
   }
-  throw std::runtime_error(msg);
+  throw CollectiveError(msg);  // every rank throws it: the caller can stop cleanly
 }
 
 // Runs a local step and agrees on its outcome, so a failure on one rank cannot leave the others

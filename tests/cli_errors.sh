@@ -68,6 +68,10 @@ cat >>inf.xml <<'XML'
 </ParameterList>
 XML
 expect inf 3 'NaN or Inf at step 1' 'global id' 'reference position'
+# A missing checkpoint stops both ranks cleanly (exit 3, no abort).
+base '' '<Parameter name="Restart From" type="string" value="nowhere/checkpoint.h5"/>' >no_checkpoint.xml
+expect no_checkpoint 3 'nowhere/checkpoint.h5'
+grep -q "MPI_ABORT" no_checkpoint.out && fail "no_checkpoint: aborted instead of stopping cleanly"
 # A valid input validates, and --print-defaults is XML that documents every parameter.
 base '' '' >valid.xml
 run 2 1 --validate valid.xml | grep -q "is valid" || fail "--validate of a valid input"
