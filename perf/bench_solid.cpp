@@ -1,0 +1,169 @@
+// Google Benchmark of the micropolar correspondence kernels on one rank: pass 1 (K, eps, kappa,
+// constitutive update, stabilization Q1/Q2 and energy), pass 2 (force and moment densities) and
+// the whole force evaluation (solid_forces: pass 1, ghost refresh, pass 2), in 2D (400 x 400)
+// and 3D (50^3) at delta = 3.015 dx and 4.015 dx.
+// Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads ./perf/bench_solid
+#include <benchmark/benchmark.h>
+
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <Tpetra_Core.hpp>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <tuple>
+
+#include "mupm/discretization.hpp"
+#include "mupm/solid.hpp"
+
+namespace {
+
+using namespace mupm;
+
+Teuchos::RCP<const Comm> self() {
+  return Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+}
+
+// The material of tests/test_solid.cpp: the numbers only need to be realistic
+// so that no kernel takes a special path (degenerate K, zero stabilization).
+const MicropolarElastic kLaw =
+    MicropolarElastic::from_bulk_shear(270.83e6, 220.33e6, 100e6, 7.5e-3);
+
+template <int Dim>
+struct Body {
+  Discretization<Dim> disc;
+  SolidParams prm;
+  SolidState<Dim> st;
+
+  explicit Body(const GridSpec<Dim>& g) : disc(discretize(self(), g)) {
+    prm.law = kLaw;
+    prm.stabilization = 0.5;
+    prm.stab_modulus =
+        stabilization_modulus<Dim>(kLaw, g.horizon, g.thickness, StabilizationModulus::Automatic);
+    prm.horizon_volume = Dim == 2 ? kPi * g.horizon * g.horizon * g.thickness
+                                  : 4.0 / 3.0 * kPi * std::pow(g.horizon, 3);
+    st.allocate(disc.points.size(), disc.points.n_owned);
+    set_field();
+    // Pass 2 reads pass 1's outputs: run the whole evaluation once so that pass 2 alone sees
+    // real eps, kappa, P1, P2, w0 (and the pages are touched before timing).
+    solid_forces(disc.points, disc.bonds, prm, st, disc.dist);
+    Kokkos::fence();
+  }
+
+  // Small sinusoids in u and theta (owned and ghosts): a non-affine field, so eps, kappa and
+  // the stabilization residuals are non-zero and no arithmetic is skipped or trivially zero.
+  void set_field() {
+    auto x = disc.points.x, u = disc.points.u, th = disc.points.theta;
+    const double k = 2 * kPi / (37 * disc.grid.dx);  // wavelength not commensurate with dx
+    Kokkos::parallel_for(
+        "bench::set_field", range(0, disc.points.size()), KOKKOS_LAMBDA(const std::size_t i) {
+          for (int d = 0; d < Dim; ++d)
+            u(i, d) = 1e-6 * std::sin(k * x(i, d) + d) * std::cos(k * x(i, (d + 1) % Dim));
+          for (int r = 0; r < kRotDim<Dim>; ++r)
+            th(i, r) = 1e-4 * std::cos(k * x(i, r % Dim) - r);
+        });
+    Kokkos::fence();
+  }
+};
+
+// Set-up (discretization and neighbour build, up to seconds in 3D) is shared by the three
+// benchmarks of a configuration and by the repeated calls Google Benchmark makes of each.
+using Key = std::tuple<int, long long, long long>;
+std::map<Key, std::shared_ptr<void>>& cache() {
+  static std::map<Key, std::shared_ptr<void>> bodies;
+  return bodies;
+}
+
+// state.range(0): points per axis; state.range(1): horizon factor x 1000.
+template <int Dim>
+Body<Dim>& body(const benchmark::State& state) {
+  const Key key{Dim, state.range(0), state.range(1)};
+  auto& slot = cache()[key];
+  if (!slot) {
+    GridSpec<Dim> g;
+    g.counts.fill(state.range(0));
+    g.dx = 1e-3;
+    g.horizon = state.range(1) / 1000.0 * g.dx;
+    slot = std::make_shared<Body<Dim>>(g);
+  }
+  return *std::static_pointer_cast<Body<Dim>>(slot);
+}
+
+template <int Dim>
+void set_counters(benchmark::State& state, const Body<Dim>& b) {
+  const double n_bonds = double(b.disc.bonds.size()), n_points = double(b.disc.points.n_owned);
+  state.counters["points"] = n_points;
+  state.counters["bonds"] = n_bonds;
+  state.counters["bond_updates_per_s"] =
+      benchmark::Counter(n_bonds, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["points_per_s"] =
+      benchmark::Counter(n_points, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+template <int Dim>
+void BM_SolidPass1(benchmark::State& state) {
+  auto& b = body<Dim>(state);
+  for (auto _ : state) {
+    solid_pass1(b.disc.points, b.disc.bonds, b.prm, b.st);
+    Kokkos::fence();
+  }
+  set_counters(state, b);
+}
+
+template <int Dim>
+void BM_SolidPass2(benchmark::State& state) {
+  auto& b = body<Dim>(state);
+  for (auto _ : state) {
+    solid_pass2(b.disc.points, b.disc.bonds, b.prm, b.st);
+    Kokkos::fence();
+  }
+  set_counters(state, b);
+}
+
+// What one explicit step spends on the solid: pass 1, the refresh of the pass-2 ghost fields
+// (a Tpetra import, no ghosts on one rank but its fixed cost is paid) and pass 2.
+template <int Dim>
+void BM_SolidForces(benchmark::State& state) {
+  auto& b = body<Dim>(state);
+  for (auto _ : state) {
+    solid_forces(b.disc.points, b.disc.bonds, b.prm, b.st, b.disc.dist);
+    Kokkos::fence();
+  }
+  set_counters(state, b);
+}
+
+// Grouped by configuration so that the output reads pass1, pass2, forces for each grid.
+// UseRealTime: Google Benchmark's default clock (and so every rate counter) is the CPU time of
+// the calling thread alone, not the wall time of the parallel region: on a loaded machine the
+// main thread waits off-CPU while the other OpenMP threads finish, and the rates come out up
+// to T times too high.
+#define MUPM_SOLID_BENCH(Dim, n, factor)  \
+  BENCHMARK_TEMPLATE(BM_SolidPass1, Dim)  \
+      ->Args({n, factor})                 \
+      ->Unit(benchmark::kMillisecond)     \
+      ->UseRealTime();                    \
+  BENCHMARK_TEMPLATE(BM_SolidPass2, Dim)  \
+      ->Args({n, factor})                 \
+      ->Unit(benchmark::kMillisecond)     \
+      ->UseRealTime();                    \
+  BENCHMARK_TEMPLATE(BM_SolidForces, Dim) \
+      ->Args({n, factor})                 \
+      ->Unit(benchmark::kMillisecond)     \
+      ->UseRealTime()
+
+MUPM_SOLID_BENCH(2, 400, 3015);
+MUPM_SOLID_BENCH(2, 400, 4015);
+MUPM_SOLID_BENCH(3, 50, 3015);
+MUPM_SOLID_BENCH(3, 50, 4015);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Tpetra::ScopeGuard scope(&argc, &argv);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv))
+    return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  cache().clear();  // the Views must go before Kokkos is finalized by the scope guard
+  return 0;
+}
