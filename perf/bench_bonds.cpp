@@ -2,11 +2,7 @@
 // count -> scan -> fill, rows sorted by global id) and a bond loop that gathers neighbour data
 // (the shape tensor of pass 1, eq 45), in 2D and 3D at delta = 3.015 dx and 4.015 dx.
 // Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads ./perf/bench_bonds
-#include <benchmark/benchmark.h>
-
-#include <Teuchos_DefaultMpiComm.hpp>
-#include <Tpetra_Core.hpp>
-
+#include "bench_common.hpp"
 #include "mupm/discretization.hpp"
 #include "mupm/shape_tensor.hpp"
 
@@ -14,23 +10,12 @@ namespace {
 
 using namespace mupm;
 
-Teuchos::RCP<const Comm> self() {
-  return Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-}
-
-template <int Dim>
-GridSpec<Dim> grid(long long n_per_axis, double factor) {
-  GridSpec<Dim> g;
-  g.counts.fill(n_per_axis);
-  g.dx = 1e-3;
-  g.horizon = factor * g.dx;
-  return g;
-}
+using bench::self;
 
 // state.range(0): points per axis; state.range(1): horizon factor x 1000.
 template <int Dim>
 void BM_NeighborBuild(benchmark::State& state) {
-  const auto g = grid<Dim>(state.range(0), state.range(1) / 1000.0);
+  const auto g = bench::grid<Dim>(state);
   auto disc = discretize(self(), g);
   for (auto _ : state) {
     auto bonds = build_bonds(disc.points, g.horizon, g.cracks);
@@ -48,7 +33,7 @@ void BM_NeighborBuild(benchmark::State& state) {
 
 template <int Dim>
 void BM_ShapeTensorBondLoop(benchmark::State& state) {
-  const auto g = grid<Dim>(state.range(0), state.range(1) / 1000.0);
+  const auto g = bench::grid<Dim>(state);
   auto disc = discretize(self(), g);
   Vectors K("K", disc.points.n_owned, Dim * Dim);
   compute_shape_tensor(disc.points, disc.bonds, K);  // warm-up
@@ -95,11 +80,5 @@ BENCHMARK_TEMPLATE(BM_ShapeTensorBondLoop, 3)
 }  // namespace
 
 int main(int argc, char** argv) {
-  Tpetra::ScopeGuard scope(&argc, &argv);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv))
-    return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return mupm::bench::run(argc, argv);
 }

@@ -3,15 +3,12 @@
 // the whole force evaluation (solid_forces: pass 1, ghost refresh, pass 2), in 2D (400 x 400)
 // and 3D (50^3) at delta = 3.015 dx and 4.015 dx.
 // Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads ./perf/bench_solid
-#include <benchmark/benchmark.h>
-
-#include <Teuchos_DefaultMpiComm.hpp>
-#include <Tpetra_Core.hpp>
 #include <cmath>
 #include <map>
 #include <memory>
 #include <tuple>
 
+#include "bench_common.hpp"
 #include "mupm/discretization.hpp"
 #include "mupm/solid.hpp"
 
@@ -19,9 +16,7 @@ namespace {
 
 using namespace mupm;
 
-Teuchos::RCP<const Comm> self() {
-  return Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-}
+using bench::self;
 
 // The material of tests/test_solid.cpp: the numbers only need to be realistic
 // so that no kernel takes a special path (degenerate K, zero stabilization).
@@ -79,11 +74,7 @@ Body<Dim>& body(const benchmark::State& state) {
   const Key key{Dim, state.range(0), state.range(1)};
   auto& slot = cache()[key];
   if (!slot) {
-    GridSpec<Dim> g;
-    g.counts.fill(state.range(0));
-    g.dx = 1e-3;
-    g.horizon = state.range(1) / 1000.0 * g.dx;
-    slot = std::make_shared<Body<Dim>>(g);
+    slot = std::make_shared<Body<Dim>>(bench::grid<Dim>(state));
   }
   return *std::static_pointer_cast<Body<Dim>>(slot);
 }
@@ -158,12 +149,6 @@ MUPM_SOLID_BENCH(3, 50, 4015);
 }  // namespace
 
 int main(int argc, char** argv) {
-  Tpetra::ScopeGuard scope(&argc, &argv);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv))
-    return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  cache().clear();  // the Views must go before Kokkos is finalized by the scope guard
-  return 0;
+  // The cached bodies' Views must go before the scope guard finalizes Kokkos.
+  return mupm::bench::run(argc, argv, [] { cache().clear(); });
 }
