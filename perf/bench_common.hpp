@@ -7,6 +7,9 @@
 #include <Teuchos_DefaultMpiComm.hpp>
 #include <Tpetra_Core.hpp>
 #include <functional>
+#include <map>
+#include <memory>
+#include <tuple>
 
 #include "mupm/grid.hpp"
 
@@ -24,6 +27,36 @@ GridSpec<Dim> grid(const benchmark::State& state) {
   g.dx = 1e-3;
   g.horizon = double(state.range(1)) / 1000.0 * g.dx;
   return g;
+}
+
+// Set-up (discretization and neighbour build, up to seconds in 3D) is shared by the benchmarks
+// of a configuration and by the repeated calls Google Benchmark makes of each: one Body per
+// (type, points per axis, horizon factor), built on first use, dropped by release_bodies().
+using Key = std::tuple<const void*, long long, long long>;
+inline std::map<Key, std::shared_ptr<void>>& bodies() {
+  static std::map<Key, std::shared_ptr<void>> cache;
+  return cache;
+}
+template <class Body>
+Body& body(const benchmark::State& state) {
+  static const char tag = 0;  // one address per Body type
+  auto& slot = bodies()[Key{&tag, state.range(0), state.range(1)}];
+  if (!slot)
+    slot = std::make_shared<Body>(grid<Body::dim>(state));
+  return *std::static_pointer_cast<Body>(slot);
+}
+inline void release_bodies() {
+  bodies().clear();
+}
+
+// Counters of a benchmark over n_bonds bonds and n_points points per iteration.
+inline void set_counters(benchmark::State& state, double n_bonds, double n_points) {
+  state.counters["points"] = n_points;
+  state.counters["bonds"] = n_bonds;
+  state.counters["bond_updates_per_s"] =
+      benchmark::Counter(n_bonds, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["points_per_s"] =
+      benchmark::Counter(n_points, benchmark::Counter::kIsIterationInvariantRate);
 }
 
 // Runs the registered benchmarks between MPI/Kokkos initialization and finalization;

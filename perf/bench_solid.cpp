@@ -4,9 +4,6 @@
 // and 3D (50^3) at delta = 3.015 dx and 4.015 dx.
 // Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads ./perf/bench_solid
 #include <cmath>
-#include <map>
-#include <memory>
-#include <tuple>
 
 #include "bench_common.hpp"
 #include "mupm/discretization.hpp"
@@ -25,6 +22,7 @@ const MicropolarElastic kLaw =
 
 template <int Dim>
 struct Body {
+  static constexpr int dim = Dim;
   Discretization<Dim> disc;
   SolidParams prm;
   SolidState<Dim> st;
@@ -60,34 +58,13 @@ struct Body {
   }
 };
 
-// Set-up (discretization and neighbour build, up to seconds in 3D) is shared by the three
-// benchmarks of a configuration and by the repeated calls Google Benchmark makes of each.
-using Key = std::tuple<int, long long, long long>;
-std::map<Key, std::shared_ptr<void>>& cache() {
-  static std::map<Key, std::shared_ptr<void>> bodies;
-  return bodies;
-}
-
-// state.range(0): points per axis; state.range(1): horizon factor x 1000.
 template <int Dim>
 Body<Dim>& body(const benchmark::State& state) {
-  const Key key{Dim, state.range(0), state.range(1)};
-  auto& slot = cache()[key];
-  if (!slot) {
-    slot = std::make_shared<Body<Dim>>(bench::grid<Dim>(state));
-  }
-  return *std::static_pointer_cast<Body<Dim>>(slot);
+  return bench::body<Body<Dim>>(state);
 }
-
 template <int Dim>
 void set_counters(benchmark::State& state, const Body<Dim>& b) {
-  const double n_bonds = double(b.disc.bonds.size()), n_points = double(b.disc.points.n_owned);
-  state.counters["points"] = n_points;
-  state.counters["bonds"] = n_bonds;
-  state.counters["bond_updates_per_s"] =
-      benchmark::Counter(n_bonds, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["points_per_s"] =
-      benchmark::Counter(n_points, benchmark::Counter::kIsIterationInvariantRate);
+  bench::set_counters(state, double(b.disc.bonds.size()), double(b.disc.points.n_owned));
 }
 
 template <int Dim>
@@ -150,5 +127,5 @@ MUPM_SOLID_BENCH(3, 50, 4015);
 
 int main(int argc, char** argv) {
   // The cached bodies' Views must go before the scope guard finalizes Kokkos.
-  return mupm::bench::run(argc, argv, [] { cache().clear(); });
+  return mupm::bench::run(argc, argv, mupm::bench::release_bodies);
 }

@@ -23,8 +23,8 @@ using Teuchos::RCP;
 using Teuchos::rcp;
 
 const std::vector<std::string> kIcFields = {
-    "Displacement",  "Velocity",          "Micro-Rotation", "Micro-Rotation Rate",
-    "Pore Pressure", "Fracture Pressure", "Porosity",       "Saturation"};
+    "Displacement",      "Velocity", "Micro-Rotation", "Micro-Rotation Rate",      "Pore Pressure",
+    "Fracture Pressure", "Porosity", "Saturation",     "Hydrostatic Pore Pressure"};
 const std::vector<std::string> kFaces = {"-x", "+x", "-y", "+y", "-z", "+z"};
 
 template <class T>
@@ -54,7 +54,9 @@ void ic_template(ParameterList& c) {
   c.set("Field", std::string("Velocity"),
         "Field to set: Displacement, Velocity (Dim values), Micro-Rotation, Micro-Rotation Rate "
         "(1 value in 2D, 3 in 3D), Pore Pressure [Pa], Fracture Pressure [Pa], Porosity, "
-        "Saturation (1 value).",
+        "Saturation (1 value; with a fluid physics S_r follows from the pressure instead), or "
+        "Hydrostatic Pore Pressure: p = rho_w g . (x - x_0) with g = Solver->Gravity and Value "
+        "= x_0, a point of the water table (Dim values).",
         one_of(kIcFields));
   c.set("Region", std::string("All"),
         "Name of a region of Discretization->Regions, or All. Later conditions overwrite "
@@ -68,9 +70,14 @@ void bc_template(ParameterList& c) {
         "points (the boundary-layer method: use a boundary layer region), or Traction [Pa] "
         "applied as a body force traction/dx on the region's points (make it the outermost real "
         "row of the face), or Body Force [N/m^3], or Body Couple [N m/m^3] (Component: the "
-        "rotation axis).",
+        "rotation axis). Fluid (Solver->Physics = Pore Fluid or Hydro-Mechanical): Pore "
+        "Pressure [Pa] prescribed on the region's points (a drained boundary; boundaries "
+        "without one are impervious), or Fluid Source: water injected at Value [m^3/s; in 2D "
+        "m^3/s per metre of thickness] spread over the region's points by volume (a point "
+        "source: a region holding one point; a line: a one-row region; negative: extraction). "
+        "Component is ignored by the fluid conditions.",
         one_of({"Displacement", "Velocity", "Micro-Rotation", "Traction", "Body Force",
-                "Body Couple"}));
+                "Body Couple", "Pore Pressure", "Fluid Source"}));
   c.set("Region", std::string("All"), "Region name (Discretization->Regions, 'Layer -y', All).");
   c.set("Component", std::string("x"),
         "x, y or z: the displacement/velocity/traction/force component, or the rotation axis "
@@ -103,6 +110,10 @@ const std::vector<std::string>& output_field_names() {
                                                  "fracture_pressure",
                                                  "porosity",
                                                  "saturation",
+                                                 "relative_permeability",
+                                                 "darcy_flux",
+                                                 "volumetric_strain",
+                                                 "fluid_content",
                                                  "damage",
                                                  "fracture",
                                                  "flags",
@@ -183,9 +194,43 @@ RCP<ParameterList> valid_parameters() {
           one_of({"Automatic", "Eq 71", "Bulk Matching"}));
   }
   {
-    ParameterList& f = pl->sublist("Fluid", false,
-                                   "Pore fluid properties (flow comes with the pore-fluid issue).");
+    ParameterList& f = pl->sublist(
+        "Fluid", false,
+        "Pore water (Solver->Physics = Pore Fluid or Hydro-Mechanical; Water Density always).");
     f.set("Water Density", 1000.0, "rho_w [kg/m^3], in the mixture density (eq 1).", positive());
+    f.set("Fluid Bulk Modulus", 2.2e9,
+          "K_w [Pa]: storage C = phi dS_r/dp + phi S_r / K_w. Saturated points store water by "
+          "its compressibility alone; an explicit scheme cannot take K_w -> infinity "
+          "(incompressible water), and its stable steps shrink as K_w grows (the solid's by "
+          "the undrained modulus K + K_w/phi, the fluid's with C).",
+          positive());
+    f.set("Intrinsic Permeability", 0.0,
+          "k [m^2] (with Viscosity). Give either this or Hydraulic Conductivity, not both.",
+          at_least(0.0));
+    f.set("Viscosity", 1e-3,
+          "Dynamic viscosity of water mu_w [Pa s] (with Intrinsic Permeability).", positive());
+    f.set("Hydraulic Conductivity", 0.0,
+          "K_h [m/s], the paper's 'hydraulic conductivity k_w': converted by k/mu_w = K_h / "
+          "(rho_w g_0), g_0 = 9.80665 m/s^2 (whatever Solver->Gravity is). Give either this "
+          "or Intrinsic Permeability, not both.",
+          at_least(0.0));
+    f.set("Retention Model", std::string("Saturated"),
+          "Saturated: S_r = 1, k_r = 1 at any pressure. Van Genuchten: S_r = [1 + (-p/s_a)^n]^-m "
+          "for p < 0 (eq 12), Mualem k_r = S_r^1/2 [1 - (1 - S_r^(1/m))^m]^2 (eq 56).",
+          one_of({"Saturated", "Van Genuchten"}));
+    f.set("Air Entry Pressure", 1e4, "s_a [Pa] of eq 12 (Van Genuchten).", positive());
+    f.set("Van Genuchten n", 2.0, "n of eq 12 (> 1).", positive());
+    f.set("Van Genuchten m", 0.0, "m of eqs 12 and 56 in (0, 1); 0: Mualem's m = 1 - 1/n.",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 0.999999)));
+    f.set("Flow Stabilization", 0.5,
+          "G in [0, 1] of the flow stabilization (eqs 72-78): bond-wise diffusion of the "
+          "non-uniform part of p that damps checkerboard pressure modes; G = 1 gives bond "
+          "conductances equal to the uniform-weight bond-based model's (derivation in "
+          "include/mupm/fluid.hpp).",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1.0)));
+    f.set("Gravity In Darcy Flux", true,
+          "Darcy's law with gravity, q = -(k_r k / mu_w)(grad p - rho_w g) with g = "
+          "Solver->Gravity (eq 54); false: q = -(k_r k / mu_w) grad p.");
   }
   pl->sublist("Fracture", false, "Bond breakage and fracture flow (filled by the fracture issue).");
   {
@@ -206,8 +251,27 @@ RCP<ParameterList> valid_parameters() {
           "Physics advanced each step. Micropolar Solid: the stabilized micropolar "
           "correspondence solid (Materials), explicit central difference. Kinematics Only: no "
           "internal forces (points move with their velocity); damage from intact bonds (eq 37) "
-          "either way. Fluid and fracture models come with later issues.",
-          one_of({"Micropolar Solid", "Kinematics Only"}));
+          "either way. Pore Fluid: unsaturated flow in a rigid skeleton (Fluid), explicit in "
+          "p. Hydro-Mechanical: both, staggered (Staggering), coupled by the total stress "
+          "sigma-bar - S_r p 1 (eq 46), the mixture density (eq 1) and the volume change rate "
+          "(eq 117).",
+          one_of({"Micropolar Solid", "Kinematics Only", "Pore Fluid", "Hydro-Mechanical"}));
+    s.set("Staggering", std::string("Solid First"),
+          "Order of the staggered step (Hydro-Mechanical). Solid First: the solid steps with "
+          "the pressure held, then the fluid with the volume change they made. Fluid First: the "
+          "fluid steps with the previous interval's volume change, then the solid with the new "
+          "pressure (fluid-driven problems). Both agree as Time Step -> 0.",
+          one_of({"Solid First", "Fluid First"}));
+    s.set("Solid Steps Per Fluid Step", 1,
+          "Hydro-Mechanical: the fluid advances once every this many solid steps, over their "
+          "combined interval (a larger fluid step when flow is slow).",
+          at_least(1));
+    s.set("Fluid Substeps", 1,
+          "Equal fluid steps per fluid interval (sub-cycling when flow is faster than the "
+          "solid); 0: as many as Time Step Safety Factor x the estimated stable fluid step "
+          "requires. With Physics = Pore Fluid the interval is Time Step (Automatic Time Step "
+          "sets it to the safety factor x the stable fluid step).",
+          at_least(0));
     s.set("Time Step", 1e-6, "Time step dt [s] (> 0).", positive());
     s.set("Automatic Time Step", false,
           "Use Time Step Safety Factor x the estimated stable step instead of Time Step.");
@@ -240,7 +304,8 @@ RCP<ParameterList> valid_parameters() {
     o.set("Fields", Array<std::string>({"displacement", "velocity", "damage", "fracture"}),
           "Point fields written at each field output. Any of: displacement, velocity, "
           "acceleration, micro_rotation, micro_rotation_rate, pore_pressure, fracture_pressure, "
-          "porosity, saturation, damage, fracture, flags, regions, stress, couple_stress, "
+          "porosity, saturation, relative_permeability, darcy_flux, volumetric_strain, "
+          "fluid_content, damage, fracture, flags, regions, stress, couple_stress, "
           "plastic_strain. Global id and reference position are always written.",
           rcp(new Teuchos::ArrayStringValidator(one_of(output_field_names()))));
     o.set("Time Series Interval", 1, "Steps between rows of time_series.csv (>= 1).", at_least(1));
@@ -461,10 +526,11 @@ void check_dimension_arrays(ParameterList& input) {
   for (auto it = ics.begin(); it != ics.end(); ++it) {
     ParameterList& c = ics.sublist(ics.name(it));
     const std::string field = c.get<std::string>("Field");
-    const std::size_t n = (field == "Displacement" || field == "Velocity") ? dim
-                          : (field == "Micro-Rotation" || field == "Micro-Rotation Rate")
-                              ? (dim == 2 ? 1 : 3)
-                              : 1;
+    const std::size_t n =
+        (field == "Displacement" || field == "Velocity" || field == "Hydrostatic Pore Pressure")
+            ? dim
+        : (field == "Micro-Rotation" || field == "Micro-Rotation Rate") ? (dim == 2 ? 1 : 3)
+                                                                        : 1;
     get_array<double>(c, "Value", n, field);
     check_region(c, regions, faces);
   }
@@ -497,12 +563,39 @@ void check_dimension_arrays(ParameterList& input) {
   const ParameterList& solver = input.sublist("Solver");
   if (!solver.get<Array<double>>("Gravity").empty())
     get_array<double>(solver, "Gravity", dim, "m/s^2");
-  if (solver.get<std::string>("Physics") == "Micropolar Solid") {
+  const std::string physics = solver.get<std::string>("Physics");
+  const bool fluid = physics == "Pore Fluid" || physics == "Hydro-Mechanical";
+  for (auto it = bcs.begin(); it != bcs.end(); ++it) {
+    const ParameterList& c = bcs.sublist(bcs.name(it));
+    const std::string type = c.get<std::string>("Type");
+    if (!fluid && (type == "Pore Pressure" || type == "Fluid Source"))
+      throw InputError("Error, " + path_of(c, "Type") + " = " + type +
+                       " needs Solver->Physics = Pore Fluid or Hydro-Mechanical (it is " + physics +
+                       ").");
+  }
+  if (fluid) {
+    const ParameterList& f = input.sublist("Fluid");
+    const double k = f.get<double>("Intrinsic Permeability"),
+                 kh = f.get<double>("Hydraulic Conductivity");
+    if ((k > 0) == (kh > 0))
+      throw InputError("Error, " + path_of(f, "Intrinsic Permeability") + " [m^2] or " +
+                       path_of(f, "Hydraulic Conductivity") + " [m/s]: give exactly one of them " +
+                       "> 0 for Solver->Physics = " + physics + " (" +
+                       (k > 0 ? "both are set" : "neither is set") + ").");
+    if (f.get<std::string>("Retention Model") == "Van Genuchten" &&
+        !(f.get<double>("Van Genuchten n") > 1))
+      throw InputError("Error, " + path_of(f, "Van Genuchten n") + " must be > 1.");
+    if (!(input.sublist("Materials").get<double>("Porosity") > 0))
+      throw InputError("Error, " + path_of(input.sublist("Materials"), "Porosity") +
+                       " must be > 0 for Solver->Physics = " + physics +
+                       " (the pores hold the water).");
+  }
+  if (physics == "Micropolar Solid" || physics == "Hydro-Mechanical") {
     const ParameterList& m = input.sublist("Materials");
     for (const char* k : {"Bulk Modulus", "Shear Modulus", "Length Scale"})
       if (!(m.get<double>(k) > 0))
         throw InputError("Error, " + path_of(m, k) +
-                         " must be > 0 for Solver->Physics = Micropolar Solid.");
+                         " must be > 0 for Solver->Physics = " + physics + ".");
     const std::string sm = m.get<std::string>("Stabilization Modulus");
     const double K = m.get<double>("Bulk Modulus"), mu = m.get<double>("Shear Modulus");
     if (sm == "Eq 71" && (dim == 2 || mu - (K - 2 * mu / 3) <= 0))
@@ -788,7 +881,9 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterLis
               : type == "Micro-Rotation" ? BoundaryCondition::MicroRotation
               : type == "Traction"       ? BoundaryCondition::Traction
               : type == "Body Force"     ? BoundaryCondition::BodyForce
-                                         : BoundaryCondition::BodyCouple;
+              : type == "Body Couple"    ? BoundaryCondition::BodyCouple
+              : type == "Pore Pressure"  ? BoundaryCondition::PorePressure
+                                         : BoundaryCondition::FluidSource;
     bc.region_mask = region_mask(names, c.get<std::string>("Region"));
     bc.component = c.get<std::string>("Component")[0] - 'x';
     // In 2D the only rotation component, about z, is theta's component 0.

@@ -11,8 +11,10 @@
 #include <sstream>
 
 #include "mupm/csv.hpp"
+#include "mupm/fluid_solver.hpp"
 #include "mupm/hdf5_io.hpp"
 #include "mupm/solid_solver.hpp"
+#include "mupm/staggered.hpp"
 #include "mupm/timers.hpp"
 #include "mupm/xdmf.hpp"
 
@@ -70,6 +72,11 @@ std::vector<NamedField> state_fields(const Points<Dim>& p) {
           {"fracture_pressure_rate", as_vectors(p.pf_rate)},
           {"porosity", as_vectors(p.porosity)},
           {"saturation", as_vectors(p.saturation)},
+          {"relative_permeability", as_vectors(p.rel_perm)},
+          {"darcy_flux", p.darcy_flux},
+          {"volumetric_strain", as_vectors(p.vol_strain)},
+          {"volumetric_strain_reference", as_vectors(p.vol_strain_ref)},
+          {"fluid_content", as_vectors(p.fluid_content)},
           {"damage", as_vectors(p.damage)},
           {"stress", p.stress},
           {"couple_stress", p.couple_stress},
@@ -77,8 +84,28 @@ std::vector<NamedField> state_fields(const Points<Dim>& p) {
 }
 
 template <int Dim>
-void apply_initial_conditions(const std::vector<InitialCondition>& ics, Points<Dim>& p) {
+void apply_initial_conditions(const std::vector<InitialCondition>& ics, Points<Dim>& p,
+                              Kokkos::Array<double, 3> rho_w_g) {
   for (const auto& ic : ics) {
+    if (ic.field == "Hydrostatic Pore Pressure") {
+      Kokkos::Array<double, 3> x0{};
+      for (std::size_t c = 0; c < ic.value.size() && c < 3; ++c)
+        x0[c] = ic.value[c];
+      const std::uint32_t mask = ic.region_mask;
+      auto regions = p.regions;
+      auto x = p.x;
+      auto pw = p.p;
+      Kokkos::parallel_for(
+          "mupm::Setup::hydrostatic", range(0, p.size()), KOKKOS_LAMBDA(const std::size_t i) {
+            if (mask != 0 && (regions(i) & mask) == 0)
+              return;
+            double s = 0;
+            for (int d = 0; d < Dim; ++d)
+              s += rho_w_g[d] * (x(i, d) - x0[d]);
+            pw(i) = s;
+          });
+      continue;
+    }
     Vectors target;
     for (const auto& f : state_fields(p)) {
       if ((ic.field == "Displacement" && f.name == "displacement") ||
@@ -281,6 +308,16 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
 
 namespace {
 
+// A stable-step estimate rounded down to 3 significant digits: the power iteration's sums over
+// ranks differ in the last bits between rank counts, and an automatic step must not, or runs
+// on different rank counts (and restarts) would diverge at round-off.
+double three_digits(double x) {
+  if (!(x > 0))
+    return x;
+  const double scale = std::pow(10.0, std::floor(std::log10(x)) - 2);
+  return std::floor(x / scale * (1 + 1e-12)) * scale;
+}
+
 std::string format_seconds(double s) {
   char buf[64];
   if (s < 120)
@@ -476,9 +513,19 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   }
 
   const auto& materials = input.sublist("Materials");
+  const auto& fluid_input = input.sublist("Fluid");
+  const double rho_w = fluid_input.get<double>("Water Density");
+  Kokkos::Array<double, 3> gravity{}, rho_w_g{};
+  {
+    const auto g = solver.get<Teuchos::Array<double>>("Gravity");
+    for (Teuchos::Ordinal k = 0; k < g.size() && k < 3; ++k) {
+      gravity[k] = g[k];
+      rho_w_g[k] = rho_w * g[k];
+    }
+  }
   Kokkos::deep_copy(pts.porosity, materials.get<double>("Porosity"));
   Kokkos::deep_copy(pts.saturation, 1.0);  // saturated unless an initial condition says otherwise
-  apply_initial_conditions(initial_conditions_from_input(input), pts);
+  apply_initial_conditions(initial_conditions_from_input(input), pts, rho_w_g);
   long long step = 0;
   double time = 0;
   std::vector<double> history, solver_globals;
@@ -495,10 +542,45 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   }();
   disc.dist.refresh(ghosted);
 
-  // The physics. Solid: the micropolar solid step; otherwise kinematics only.
-  const bool solid = solver.get<std::string>("Physics") == "Micropolar Solid";
+  // The physics: the micropolar solid step, the pore-fluid step, both (staggered), or
+  // kinematics only.
+  const std::string physics = solver.get<std::string>("Physics");
+  const bool solid = physics == "Micropolar Solid" || physics == "Hydro-Mechanical";
+  const bool fluid = physics == "Pore Fluid" || physics == "Hydro-Mechanical";
+  const auto bcs = boundary_conditions_from_input(input);
   std::unique_ptr<SolidSolver<Dim>> solid_solver;
+  std::unique_ptr<FluidSolver<Dim>> fluid_solver;
   double dt = solver.get<double>("Time Step");
+  const double safety = solver.get<double>("Time Step Safety Factor");
+  const bool automatic_dt = solver.get<bool>("Automatic Time Step");
+  const std::size_t solid_globals = solid ? SolidSolver<Dim>::n_globals + 1 : 0;
+  if (fluid) {
+    FluidParams fp;
+    fp.water_density = rho_w;
+    fp.bulk_modulus = fluid_input.get<double>("Fluid Bulk Modulus");
+    const double k = fluid_input.get<double>("Intrinsic Permeability");
+    fp.mobility =
+        k > 0 ? k / fluid_input.get<double>("Viscosity")
+              : fluid_input.get<double>("Hydraulic Conductivity") / (rho_w * kStandardGravity);
+    if (fluid_input.get<std::string>("Retention Model") == "Van Genuchten") {
+      const double n = fluid_input.get<double>("Van Genuchten n");
+      fp.retention = VanGenuchten::mualem(fluid_input.get<double>("Air Entry Pressure"), n);
+      const double m = fluid_input.get<double>("Van Genuchten m");
+      if (m > 0)
+        fp.retention.m = m;
+    }
+    fp.stabilization = fluid_input.get<double>("Flow Stabilization");
+    fp.horizon_volume = Dim == 2 ? kPi * grid.horizon * grid.horizon * grid.thickness
+                                 : 4.0 / 3.0 * kPi * std::pow(grid.horizon, 3);
+    fp.second_moment = family_second_moment<Dim>(grid.horizon, grid.thickness);
+    if (fluid_input.get<bool>("Gravity In Darcy Flux"))
+      fp.gravity = gravity;
+    fluid_solver = std::make_unique<FluidSolver<Dim>>(disc, fp, bcs, mpi);
+    if (solver_globals.size() > solid_globals)
+      fluid_solver->set_globals(
+          std::vector<double>(solver_globals.begin() + long(solid_globals), solver_globals.end()));
+    fluid_solver->initialize(time, !restart.empty());
+  }
   if (solid) {
     SolidParams prm;
     prm.law = MicropolarElastic::from_bulk_shear(
@@ -515,29 +597,57 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
                                   : 4.0 / 3.0 * kPi * std::pow(grid.horizon, 3);
     typename SolidSolver<Dim>::Settings settings;
     settings.rho_s = materials.get<double>("Solid Density");
-    settings.rho_w = input.sublist("Fluid").get<double>("Water Density");
-    const auto g = solver.get<Teuchos::Array<double>>("Gravity");
-    for (Teuchos::Ordinal k = 0; k < g.size(); ++k)
-      settings.gravity[k] = g[k];
+    settings.rho_w = rho_w;
+    settings.gravity = gravity;
     settings.damping = solver.get<double>("Damping");
-    solid_solver = std::make_unique<SolidSolver<Dim>>(
-        disc, prm, boundary_conditions_from_input(input), settings, mpi);
+    solid_solver = std::make_unique<SolidSolver<Dim>>(disc, prm, bcs, settings, mpi);
     solid_solver->set_globals(solver_globals);
     solid_solver->initialize(time, !restart.empty());
-    const double stable = solid_solver->estimate_stable_dt();
-    const double safety = solver.get<double>("Time Step Safety Factor");
-    if (solver.get<bool>("Automatic Time Step"))
+    if (fluid && restart.empty())
+      fluid_solver->reset_strain_reference();
+    const double stiffening = fluid ? fluid_solver->undrained_stiffening() : 0.0;
+    const double stable = three_digits(solid_solver->estimate_stable_dt());
+    if (automatic_dt)
       dt = safety * stable;
     if (rank == 0) {
       out << "mupm: micropolar solid, stabilization G = " << prm.stabilization
-          << ", D = " << prm.stab_modulus << " Pa/m^2; estimated stable dt = " << stable
-          << " s; dt = " << dt << " s\n";
+          << ", D = " << prm.stab_modulus << " Pa/m^2; estimated stable dt = " << stable << " s"
+          << (fluid ? " (undrained, pore water adds " + std::to_string(stiffening) + " Pa)" : "")
+          << "; dt = " << dt << " s\n";
       if (dt > safety * stable)
         out << "mupm: WARNING: Solver->Time Step = " << dt << " s exceeds "
             << "Time Step Safety Factor x the estimated stable step = " << safety * stable
             << " s: the run may blow up. Use a smaller Time Step or Automatic Time Step.\n";
     }
   }
+  // The fluid advances every `fluid_every` solid steps (1 without a solid) over that interval,
+  // in `fluid_substeps` equal steps.
+  const int fluid_every = solid ? solver.get<int>("Solid Steps Per Fluid Step") : 1;
+  int fluid_substeps = solver.get<int>("Fluid Substeps");
+  const bool fluid_first = solver.get<std::string>("Staggering") == "Fluid First";
+  if (fluid) {
+    const double stable_f = three_digits(fluid_solver->estimate_stable_dt());
+    if (!solid && automatic_dt)
+      dt = safety * stable_f;
+    const double interval = fluid_every * dt;
+    if (fluid_substeps == 0)
+      fluid_substeps = std::max(1, int(std::ceil(interval / (safety * stable_f) - 1e-9)));
+    const double dt_f = interval / fluid_substeps;
+    if (rank == 0) {
+      out << "mupm: pore fluid, k/mu_w = " << fluid_solver->params().mobility
+          << " m^2/(Pa s), K_w = " << fluid_solver->params().bulk_modulus
+          << " Pa, flow stabilization G = " << fluid_solver->params().stabilization
+          << "; estimated stable fluid dt = " << stable_f << " s; fluid dt = " << dt_f << " s ("
+          << fluid_substeps << " substep(s) every " << fluid_every << " step(s), "
+          << (solid ? (fluid_first ? "fluid first" : "solid first") : "fluid only") << ")\n";
+      if (dt_f > safety * stable_f)
+        out << "mupm: WARNING: the fluid step " << dt_f << " s exceeds Time Step Safety Factor x "
+            << "the estimated stable fluid step = " << safety * stable_f
+            << " s: the pressure may blow up. Raise Solver->Fluid Substeps (0: automatic).\n";
+    }
+  }
+  Staggered<Dim> staggered{solid_solver.get(), fluid_solver.get(), fluid_first, fluid_every,
+                           fluid_substeps};
   const long long n_steps = solver.get<int>("Number of Steps");
   const long long first_step = step, last_step = n_steps;
   const int field_interval = output.get<int>("Field Interval");
@@ -551,10 +661,15 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   std::vector<std::string> columns{"step", "time", "max_displacement", "mean_damage",
                                    "broken_bonds"};
   if (solid) {
-    for (const char* c :
-         {"internal_energy", "kinetic_energy", "external_work", "dissipation", "energy_error"})
+    for (const char* c : {"internal_energy", "kinetic_energy", "external_work", "dissipation",
+                          "pore_pressure_work", "energy_error"})
       columns.push_back(c);
     for (const auto& r : solid_solver->reaction_names())
+      columns.push_back(r);
+  }
+  if (fluid) {
+    columns.push_back("fluid_mass");
+    for (const auto& r : fluid_solver->inflow_names())
       columns.push_back(r);
   }
   columns.push_back("wall_seconds");
@@ -562,8 +677,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     csv = std::make_unique<io::CsvWriter>(folder + "/time_series.csv", columns, !restart.empty());
   // Energy balance (eqs 137-140): E_int + E_kin + D - W_ext stays at its initial value.
   double energy0 = solid ? solid_solver->energy().balance() : 0.0;
-  if (solid && solver_globals.size() == 3)
-    energy0 = solver_globals[2];
+  if (solid && solver_globals.size() >= solid_globals)
+    energy0 = solver_globals[solid_globals - 1];
   const double energy_tol = solver.get<double>("Energy Tolerance");
   const bool energy_stop = solver.get<bool>("Stop On Energy Violation");
   long long energy_warnings = 0;
@@ -571,6 +686,9 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     auto g = solid ? solid_solver->globals() : std::vector<double>{};
     if (solid)
       g.push_back(energy0);
+    if (fluid)
+      for (double v : fluid_solver->globals())
+        g.push_back(v);
     return g;
   };
 
@@ -606,10 +724,15 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
                             double(broken) / 2};  // each bond is listed by both its ends
     if (solid) {
       const auto e = solid_solver->energy();
-      for (double v :
-           {e.internal, e.kinetic, e.external_work, e.dissipation, e.balance() - energy0})
+      for (double v : {e.internal, e.kinetic, e.external_work, e.dissipation, e.pore_work,
+                       e.balance() - energy0})
         row.push_back(v);
       for (double r : solid_solver->reactions())
+        row.push_back(r);
+    }
+    if (fluid) {
+      row.push_back(fluid_solver->fluid_mass());
+      for (double r : fluid_solver->inflows())
         row.push_back(r);
     }
     row.push_back(std::chrono::duration<double>(Clock::now() - t_start).count());
@@ -628,9 +751,14 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   while (step < last_step) {
     {
       ScopedRegion region("mupm::Solver::step");
-      if (solid) {
+      if (solid && fluid) {
+        staggered.step(step, time, dt);
+        compute_damage(disc.bonds, pts);
+      } else if (solid) {
         solid_solver->step(time, dt);
         compute_damage(disc.bonds, pts);
+      } else if (fluid) {
+        fluid_solver->advance(time, dt, fluid_substeps);
       } else {
         kinematic_step(pts, dt);
         compute_damage(disc.bonds, pts);
@@ -731,7 +859,8 @@ RunSummary run_simulation(const Teuchos::RCP<const Teuchos::Comm<int>>& comm,
 
 #define MUPM_INSTANTIATE(D)                                                                     \
   template std::vector<NamedField> state_fields<D>(const Points<D>&);                           \
-  template void apply_initial_conditions<D>(const std::vector<InitialCondition>&, Points<D>&);  \
+  template void apply_initial_conditions<D>(const std::vector<InitialCondition>&, Points<D>&,   \
+                                            Kokkos::Array<double, 3>);                          \
   template void compute_damage<D>(const Bonds&, Points<D>&);                                    \
   template void write_checkpoint<D>(const std::string&, const Discretization<D>&, long long,    \
                                     double, const std::vector<double>&,                         \

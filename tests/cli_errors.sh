@@ -58,6 +58,26 @@ got=$?
 set -e
 [[ $got == 2 ]] && grep -qF "cannot read the input file" missing_file.out || fail "missing file: exit $got"
 echo "ok: missing_file (exit $got)"
+# Fluid inputs: a permeability must be given exactly once; fluid conditions need a fluid physics.
+base '' '<Parameter name="Physics" type="string" value="Pore Fluid"/>' >no_permeability.xml
+expect no_permeability 2 'mupm->Fluid->Intrinsic Permeability' 'Hydraulic Conductivity' 'neither is set'
+base '' '<Parameter name="Physics" type="string" value="Hydro-Mechanical"/>' | sed '$d' >both_permeabilities.xml
+cat >>both_permeabilities.xml <<'XML'
+  <ParameterList name="Fluid">
+    <Parameter name="Intrinsic Permeability" type="double" value="1e-12"/>
+    <Parameter name="Hydraulic Conductivity" type="double" value="1e-5"/>
+  </ParameterList>
+</ParameterList>
+XML
+expect both_permeabilities 2 'mupm->Fluid->Intrinsic Permeability' 'both are set'
+base '' '' | sed '$d' >fluid_bc_on_solid.xml
+cat >>fluid_bc_on_solid.xml <<'XML'
+  <ParameterList name="Boundary Conditions"><ParameterList name="drain">
+    <Parameter name="Type" type="string" value="Pore Pressure"/>
+  </ParameterList></ParameterList>
+</ParameterList>
+XML
+expect fluid_bc_on_solid 2 'mupm->Boundary Conditions->drain->Type' 'Pore Fluid or Hydro-Mechanical'
 # A state that overflows stops both ranks at the step it appears, naming the point (exit 3).
 base '' '<Parameter name="Time Step" type="double" value="1e10"/>' | sed '$d' >inf.xml
 cat >>inf.xml <<'XML'

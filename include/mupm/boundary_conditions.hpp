@@ -1,6 +1,7 @@
 // Boundary conditions by the boundary-layer method (paper section 3): prescribed displacement,
 // velocity and micro-rotation components on regions (usually the boundary layers), and
-// tractions and body forces as body-force densities. Value types and kernels only.
+// tractions and body forces as body-force densities; prescribed pore pressure and fluid sources
+// (applied by include/mupm/fluid_solver.hpp). Value types and kernels only.
 #ifndef MUPM_BOUNDARY_CONDITIONS_HPP
 #define MUPM_BOUNDARY_CONDITIONS_HPP
 
@@ -62,7 +63,16 @@ struct TimeFunction {
 };
 
 struct BoundaryCondition {
-  enum Kind { Displacement, Velocity, MicroRotation, Traction, BodyForce, BodyCouple };
+  enum Kind {
+    Displacement,
+    Velocity,
+    MicroRotation,
+    Traction,
+    BodyForce,
+    BodyCouple,
+    PorePressure,  // prescribed p [Pa] on the region's points (drained boundary)
+    FluidSource    // water injected [m^3/s; in 2D per metre of thickness], spread by volume
+  };
   Kind kind = Displacement;
   std::string name;
   std::uint32_t region_mask = 0;  // 0: all points
@@ -72,6 +82,7 @@ struct BoundaryCondition {
   bool kinematic() const {
     return kind == Displacement || kind == Velocity || kind == MicroRotation;
   }
+  bool fluid() const { return kind == PorePressure || kind == FluidSource; }
   // Bit of Points::fixed this condition prescribes.
   template <int Dim>
   std::uint32_t fixed_bit() const {
@@ -148,7 +159,7 @@ void body_force_density(const std::vector<BoundaryCondition>& bcs, const Points<
   Kokkos::deep_copy(body, 0.0);
   Kokkos::deep_copy(couple, 0.0);
   for (const auto& bc : bcs) {
-    if (bc.kinematic())
+    if (bc.kinematic() || bc.fluid())
       continue;
     const Vectors target = bc.kind == BoundaryCondition::BodyCouple ? couple : body;
     const std::uint32_t mask = bc.region_mask;

@@ -18,6 +18,9 @@ enum PointFlag : std::uint32_t {
   kFlagLayerFace0 = 1u << 2,
 };
 
+// Bit of Points::fixed marking a prescribed pore pressure (bits 0..Dim+RotDim-1: u and theta).
+inline constexpr std::uint32_t kFixedPressure = 1u << 31;
+
 inline constexpr std::uint32_t layer_face_flag(int axis, int side) {
   return kFlagLayerFace0 << (2 * axis + side);
 }
@@ -37,7 +40,7 @@ struct Points {
   Scalars volume;  // V_i (2D: area times thickness)
   Flags flags;     // PointFlag bits
   Flags regions;   // bit r: the point lies in named region r
-  Flags fixed;     // bit d: u_d prescribed; bit Dim + r: theta_r prescribed (boundary conditions)
+  Flags fixed;     // bit d: u_d prescribed; bit Dim + r: theta_r prescribed; kFixedPressure: p
   // Kinematics of the solid (central difference, eqs 127-136).
   Vectors u, v, a;              // displacement, velocity, acceleration [n][Dim]
   Vectors theta, omega, alpha;  // micro-rotation and its rates [n][RotDim]
@@ -45,6 +48,14 @@ struct Points {
   Scalars p, p_rate;    // pore water pressure and its rate
   Scalars pf, pf_rate;  // fracture pressure and its rate
   Scalars porosity, saturation;
+  Scalars rel_perm;           // relative permeability k_r (eq 56)
+  Vectors darcy_flux;         // q [m/s] (eq 54) [n][Dim]
+  Scalars vol_strain;         // tr(eps) of the solid (eq 117)
+  Scalars vol_strain_ref;     // tr(eps) at the last fluid update
+  Scalars undrained_modulus;  // S_r / C [Pa]: dp = -(S_r/C) d(tr eps) at fixed water content;
+                              // 0 where p is prescribed or without a fluid (undrained split)
+  Scalars fluid_content;      // water volume per unit volume, phi S_r (1 + p/K_w) at t = 0 plus
+                              // the increments C dp + S_r d(tr eps) of every fluid step
   // Fracture.
   Scalars damage;  // D_i (eq 37)
   Bytes fracture;  // 1: fracture point (D >= D_cr or next to a pre-crack)
@@ -78,6 +89,12 @@ struct Points {
     pf_rate = Scalars("mupm::pf_rate", n);
     porosity = Scalars("mupm::porosity", n);
     saturation = Scalars("mupm::saturation", n);
+    rel_perm = Scalars("mupm::relative_permeability", n);
+    darcy_flux = Vectors("mupm::darcy_flux", n, Dim);
+    vol_strain = Scalars("mupm::volumetric_strain", n);
+    vol_strain_ref = Scalars("mupm::volumetric_strain_ref", n);
+    fluid_content = Scalars("mupm::fluid_content", n);
+    undrained_modulus = Scalars("mupm::undrained_modulus", n);
     damage = Scalars("mupm::damage", n);
     fracture = Bytes("mupm::fracture", n);
     stress = Vectors("mupm::stress", n, Dim * Dim);
@@ -88,7 +105,7 @@ struct Points {
   // Resident bytes of one point (all fields above).
   static constexpr std::size_t bytes_per_point() {
     return sizeof(GlobalId) + sizeof(double) * (Dim + 1) + 3 * sizeof(std::uint32_t) +
-           sizeof(double) * (3 * Dim + 3 * rot_dim + 4 + 2 + 1) + 1 +
+           sizeof(double) * (3 * Dim + 3 * rot_dim + 4 + 2 + 1) + 1 + sizeof(double) * (Dim + 5) +
            sizeof(double) * (Dim * Dim + rot_dim * Dim + 1);
   }
 };

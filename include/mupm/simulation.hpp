@@ -25,8 +25,11 @@ template <int Dim>
 std::vector<NamedField> state_fields(const Points<Dim>& p);
 
 // Applies the initial conditions to owned and ghost points alike (they are pointwise).
+// "Hydrostatic Pore Pressure" sets p = rho_w g . (x - x_0), x_0 (the Value) a point of the
+// water table, from rho_w_g = rho_w g.
 template <int Dim>
-void apply_initial_conditions(const std::vector<InitialCondition>& ics, Points<Dim>& p);
+void apply_initial_conditions(const std::vector<InitialCondition>& ics, Points<Dim>& p,
+                              Kokkos::Array<double, 3> rho_w_g = {});
 
 // D_i = 1 - sum_j rho_ij omega V_j / sum_j omega V_j over the family (eq 37) on owned points.
 template <int Dim>

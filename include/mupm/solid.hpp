@@ -17,6 +17,18 @@
 // V_j are -dPsi/du_i / V_i and -dPsi/dtheta_i / V_i, so energy, linear and angular momentum are
 // conserved by the central-difference scheme.
 //
+// Pore pressure in the total stress (undrained split). With a fluid, pass 1 uses
+//   p* = p - (S_r / C) (tr eps - tr eps_ref),
+// the pressure the point would have if no water had flowed since the last fluid update
+// (tr eps_ref; Points::undrained_modulus = S_r / C, zero where p is prescribed or without a
+// fluid). The fluid update then starts from p* and adds the flow (include/mupm/fluid_solver.hpp).
+// Using p itself (held over the solid step, "drained split") makes the pressure force lag
+// the deformation by a step: with K_w/phi much larger than the skeleton's modulus the central
+// difference is then unconditionally unstable (the lagged stiffness gives a characteristic
+// root product 1 + (omega dt)^2 > 1). With p* the pore water is an undrained stiffness
+// S_r^2 / C of the current state, whose waves the stable-step estimate includes. (Kim,
+// Tchelepi & Juanes 2011 analyse the same splits for implicit coupling.)
+//
 // A point whose intact bonds leave K singular (det K below 1e-6 of a well-conditioned K of the
 // same trace) is "degenerate": eps = kappa = 0 there and its bonds act as the stabilization
 // springs alone (T_ij = alpha1 U^, M_ij = alpha2 Omega): still the gradient of Psi, never NaN.
@@ -126,6 +138,7 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   auto intact = bonds.intact;
   auto x = pts.x, u = pts.u, th = pts.theta;
   auto vol = pts.volume, p = pts.p, sr = pts.saturation;
+  auto bu = pts.undrained_modulus, ref = pts.vol_strain_ref;
   auto sigma_v = pts.stress, m_v = pts.couple_stress;
   auto eps_v = st.eps, kap_v = st.kappa, P1 = st.P1, P2 = st.P2, w0_v = st.w0;
   auto degen = st.degenerate;
@@ -209,11 +222,18 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
             }
           }
         }
-        // Total stress sigma-bar - S_r p 1 (eq 46) less the stabilization stress, times K^-1.
+        // Total stress sigma-bar - S_r p* 1 (eq 46) less the stabilization stress, times K^-1.
+        double pe = p(i);
+        if (bu(i) != 0) {
+          double tr_eps = 0;
+          for (int d = 0; d < Dim; ++d)
+            tr_eps += eps[d * Dim + d];
+          pe -= bu(i) * (tr_eps - ref(i));  // undrained split (header)
+        }
         double S[Dim * Dim], Mm[R * Dim], p1[Dim * Dim], p2[R * Dim];
         for (int a = 0; a < Dim; ++a)
           for (int k = 0; k < Dim; ++k)
-            S[a * Dim + k] = sig[a * Dim + k] - (a == k ? sr(i) * p(i) : 0.0) - Q1[a * Dim + k];
+            S[a * Dim + k] = sig[a * Dim + k] - (a == k ? sr(i) * pe : 0.0) - Q1[a * Dim + k];
         for (int k = 0; k < R * Dim; ++k)
           Mm[k] = m[k] - Q2[k];
         mat_mul<Dim, Dim>(S, Kinv, p1);

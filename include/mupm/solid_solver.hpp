@@ -28,11 +28,16 @@ class SolidSolver {
   };
   struct Energy {
     double internal = 0, kinetic = 0, external_work = 0, dissipation = 0;
-    // E_int + E_kin + D - W_ext, which the scheme keeps constant (eq 140).
-    double balance() const { return internal + kinetic + dissipation - external_work; }
+    // Work of the pore water on the skeleton: sum over steps of sum_i V_i S_r p* d(tr eps_i)
+    // (the -S_r p* 1 part of the total stress, eq 46; p* linear in tr eps within a step, so the
+    // trapezoid rule is exact).
+    double pore_work = 0;
+    // E_int + E_kin + D - W_ext - W_pore, which the scheme keeps constant (eq 140).
+    double balance() const { return internal + kinetic + dissipation - external_work - pore_work; }
     double scale() const {
-      return std::max(std::max(std::abs(internal), kinetic),
-                      std::max(std::abs(external_work), dissipation));
+      return std::max(
+          std::max(std::abs(internal), kinetic),
+          std::max(std::max(std::abs(external_work), dissipation), std::abs(pore_work)));
     }
   };
 
@@ -46,25 +51,25 @@ class SolidSolver {
     body_ = Vectors("mupm::body_force", p.n_owned, Dim);
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", p.n_owned, Dim + R);
+    vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
   }
 
   const SolidState<Dim>& state() const { return st_; }
   const Scalars& density() const { return rho_; }
   // Work of the boundary and body forces and damping dissipation since t = 0 (for restarts).
-  std::vector<double> globals() const { return {work_, dissipation_}; }
+  static constexpr std::size_t n_globals = 3;
+  std::vector<double> globals() const { return {work_, dissipation_, pore_work_}; }
   void set_globals(const std::vector<double>& g) {
-    if (g.size() >= 2) {  // (the driver appends its own entries after these)
+    if (g.size() >= n_globals) {  // (the driver appends its own entries after these)
       work_ = g[0];
       dissipation_ = g[1];
+      pore_work_ = g[2];
     }
   }
 
-  // Marks prescribed components, computes densities (eqs 1, 13) from porosity and saturation,
-  // and the forces of the current state; at a start (not a restart, whose state holds them)
-  // also the boundary values at t and the accelerations.
-  void initialize(double t, bool restarted) {
+  // Mixture density (eq 1) and micro-inertia (eq 13) from the current porosity and saturation.
+  void update_density() {
     auto& p = disc_.points;
-    mark_fixed(bcs_, p);
     auto phi = p.porosity, sr = p.saturation;
     auto rho = rho_, J = inertia_;
     const double rho_s = set_.rho_s, rho_w = set_.rho_w, l = prm_.law.length;
@@ -73,6 +78,15 @@ class SolidSolver {
           rho(i) = mixture_density(phi(i), rho_s, sr(i), rho_w);
           J(i) = micro_inertia(phi(i), rho_s, l);
         });
+  }
+
+  // Marks prescribed components, computes densities (eqs 1, 13) from porosity and saturation,
+  // and the forces of the current state; at a start (not a restart, whose state holds them)
+  // also the boundary values at t and the accelerations.
+  void initialize(double t, bool restarted) {
+    auto& p = disc_.points;
+    mark_fixed(bcs_, p);
+    update_density();
     if (!restarted)
       apply_kinematic(bcs_, p, t, 0.0);
     disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
@@ -90,10 +104,18 @@ class SolidSolver {
     advance_positions(p, dt);
     apply_kinematic(bcs_, p, t, dt);
     increments();
-    work_ += 0.5 * power();  // old forces on the increment (trapezoid, first half)
+    // Work, dissipation and pore work of the step (this rank's points), then one reduction.
+    double w[3] = {0.5 * power(), 0, 0};  // old forces on the increment (trapezoid, first half)
+    Kokkos::deep_copy(vs_old_,
+                      Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
     forces(t + dt);
-    work_ += 0.5 * power();  // new forces (second half)
-    dissipation_ += dt * damping_power();
+    w[0] += 0.5 * power();  // new forces (second half)
+    w[1] = dt * damping_power();
+    w[2] = pore_power();
+    MPI_Allreduce(MPI_IN_PLACE, w, 3, MPI_DOUBLE, MPI_SUM, comm_);
+    work_ += w[0];
+    dissipation_ += w[1];
+    pore_work_ += w[2];
     advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                        set_.damping, dt);
   }
@@ -120,7 +142,7 @@ class SolidSolver {
         },
         e[0], e[1]);
     MPI_Allreduce(MPI_IN_PLACE, e, 2, MPI_DOUBLE, MPI_SUM, comm_);
-    return {e[0], e[1], work_, dissipation_};
+    return {e[0], e[1], work_, dissipation_, pore_work_};
   }
 
   // Force (moment) the boundary applies on each kinematic condition's points: -sum f V.
@@ -161,6 +183,8 @@ class SolidSolver {
   // the largest eigenvalue of M^-1 K of the discrete operator (prescribed components held),
   // by power iteration with the mass-weighted Rayleigh quotient (it approaches omega_max^2
   // from below). The state is restored afterwards.
+  // With a fluid the operator includes the undrained stiffness S_r^2 / C of the undrained split
+  // (include/mupm/solid.hpp): the fastest waves are the undrained ones.
   double estimate_stable_dt(int iterations = 40) {
     ScopedRegion region("mupm::Solid::stable_step");
     auto& p = disc_.points;
@@ -168,9 +192,11 @@ class SolidSolver {
     Vectors u0("u0", n, Dim), t0("t0", n, R);
     Kokkos::deep_copy(u0, p.u);
     Kokkos::deep_copy(t0, p.theta);
-    Scalars p0("p0", n);
+    Scalars p0("p0", n), ref0("ref0", n);
     Kokkos::deep_copy(p0, p.p);
+    Kokkos::deep_copy(ref0, p.vol_strain_ref);
     Kokkos::deep_copy(p.p, 0.0);  // the operator's linear part only
+    Kokkos::deep_copy(p.vol_strain_ref, 0.0);
     auto u = p.u, th = p.theta, gid = p.gid;
     auto fixed = p.fixed;
     Kokkos::parallel_for(
@@ -221,6 +247,7 @@ class SolidSolver {
     Kokkos::deep_copy(p.u, u0);
     Kokkos::deep_copy(p.theta, t0);
     Kokkos::deep_copy(p.p, p0);
+    Kokkos::deep_copy(p.vol_strain_ref, ref0);
     disc_.dist.refresh({p.u, p.theta});
     solid_forces(p, disc_.bonds, prm_, st_, disc_.dist);
     return lambda > 0 ? 2.0 / std::sqrt(lambda) : 0.0;
@@ -232,6 +259,33 @@ class SolidSolver {
     disc_.dist.refresh({p.u, p.theta});
     solid_forces(p, disc_.bonds, prm_, st_, disc_.dist);
     body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
+    auto eps = st_.eps;
+    auto vs = p.vol_strain;
+    Kokkos::parallel_for(
+        "mupm::Solid::volumetric_strain", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          double tr = 0;
+          for (int d = 0; d < Dim; ++d)
+            tr += eps(i, d * Dim + d);
+          vs(i) = tr;  // eq 117
+        });
+  }
+
+  // sum_i V_i S_r (p*_old + p*_new)/2 (tr eps_new - tr eps_old) of this step (this rank's
+  // points; step() sums over ranks).
+  double pore_power() const {
+    const auto& p = disc_.points;
+    auto vs = p.vol_strain, sr = p.saturation, pw = p.p, vol = p.volume;
+    auto bu = p.undrained_modulus, ref = p.vol_strain_ref;
+    auto old = vs_old_;
+    double w = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::pore_work", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          const double p_mid = pw(i) - bu(i) * (0.5 * (vs(i) + old(i)) - ref(i));
+          acc += vol(i) * sr(i) * p_mid * (vs(i) - old(i));
+        },
+        w);
+    return w;
   }
 
   void save_positions() {
@@ -277,7 +331,6 @@ class SolidSolver {
             acc += ((fx & (1u << (Dim + r))) ? -l(i, r) : bc(i, r)) * du(i, Dim + r) * vol(i);
         },
         w);
-    MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, comm_);
     return w;
   }
   // Damping power c (rho v.v + J omega.omega) V at the half step.
@@ -302,7 +355,6 @@ class SolidSolver {
               acc += c * J(i) * om(i, r) * om(i, r) * vol(i);
         },
         w);
-    MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, comm_);
     return w;
   }
 
@@ -314,7 +366,8 @@ class SolidSolver {
   SolidState<Dim> st_;
   Scalars rho_, inertia_;
   Vectors body_, couple_, du_;
-  double work_ = 0, dissipation_ = 0;
+  Scalars vs_old_;
+  double work_ = 0, dissipation_ = 0, pore_work_ = 0;
 };
 
 }  // namespace mupm

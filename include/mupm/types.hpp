@@ -36,6 +36,8 @@ using ConstRandomView2 = Kokkos::View<const T**, Kokkos::LayoutRight, MemSpace,
                                       Kokkos::MemoryTraits<Kokkos::RandomAccess>>;
 
 inline constexpr double kPi = 3.14159265358979323846;
+// Standard gravity [m/s^2]: converts a hydraulic conductivity to k/mu_w = K_h / (rho_w g_0).
+inline constexpr double kStandardGravity = 9.80665;
 
 // Micro-rotation components: 1 in 2D (theta about z), 3 in 3D.
 template <int Dim>

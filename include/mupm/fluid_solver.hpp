@@ -1,0 +1,311 @@
+// The fluid step of Algorithm 1: prescribed pore pressure and sources, the flow kernels of
+// include/mupm/fluid.hpp, the explicit pressure update (eqs 141-146, beta_3 = 0), fluid mass
+// and boundary inflow bookkeeping, and the stable-step estimate.
+//
+// Coupling with the solid (staggered): the solid writes tr(eps) of every owned point into
+// Points::vol_strain whenever it evaluates its forces. A fluid update over an interval dt_total
+// takes the rate (vol_strain - vol_strain_ref) / dt_total, then sets vol_strain_ref =
+// vol_strain. Solid first: the interval is the solid steps just taken. Fluid first: it is the
+// previous interval (the first update of a run sees no change).
+//
+// Mass bookkeeping: fluid_content m_i starts as phi S_r (1 + p/K_w) and every step adds
+// C dp + S_r d(tr eps), which by the mass balance equals dt (s_i - div_i) on free points. On a
+// prescribed-pressure point the reservoir supplies what the balance needs,
+//   supply_i = V_i (C dp + S_r d(tr eps) + dt div_i - dt s_i),
+// and sum_i V_i div_i = 0 (each bond's flow appears with both signs), so
+//   rho_w sum_i V_i m_i (t) - rho_w sum_i V_i m_i (0) = inflow through pressure conditions +
+//   injected water, to round-off. The test FluidSolver.MassConservation checks both.
+#ifndef MUPM_FLUID_SOLVER_HPP
+#define MUPM_FLUID_SOLVER_HPP
+
+#include <mpi.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mupm/boundary_conditions.hpp"
+#include "mupm/discretization.hpp"
+#include "mupm/fluid.hpp"
+
+namespace mupm {
+
+template <int Dim>
+class FluidSolver {
+ public:
+  FluidSolver(Discretization<Dim>& disc, const FluidParams& prm, std::vector<BoundaryCondition> bcs,
+              MPI_Comm comm)
+      : disc_(disc), prm_(prm), comm_(comm) {
+    for (auto& bc : bcs)
+      if (bc.fluid())
+        bcs_.push_back(bc);
+    auto& p = disc_.points;
+    st_.allocate(p.size(), p.n_owned);
+    source_ = Scalars("mupm::fluid_source", p.n_owned);
+    supply_ = Scalars("mupm::fluid_supply", p.n_owned);
+    inflow_.assign(bcs_.size(), 0.0);
+    region_volume_.assign(bcs_.size(), 0.0);
+  }
+
+  const FluidState<Dim>& state() const { return st_; }
+  const FluidParams& params() const { return prm_; }
+
+  // Cumulative water mass [kg] that entered through each fluid condition (for restarts).
+  std::vector<double> globals() const { return inflow_; }
+  void set_globals(const std::vector<double>& g) {
+    if (g.size() >= inflow_.size())
+      std::copy(g.begin(), g.begin() + long(inflow_.size()), inflow_.begin());
+  }
+  std::vector<std::string> inflow_names() const {
+    std::vector<std::string> n;
+    for (const auto& bc : bcs_)
+      n.push_back("fluid_inflow_" + bc.name);
+    return n;
+  }
+  const std::vector<double>& inflows() const { return inflow_; }
+
+  // Marks prescribed pressures; at a start (not a restart) sets them at t, the fluid content
+  // and the volumetric-strain reference; computes S_r, k_r, C and the flow of the state.
+  // A solid initialized afterwards computes tr(eps): then call reset_strain_reference().
+  void initialize(double t, bool restarted) {
+    auto& p = disc_.points;
+    auto regions = p.regions;
+    auto fixed = p.fixed, vol = p.volume;
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      const std::uint32_t mask = bcs_[k].region_mask;
+      if (bcs_[k].kind == BoundaryCondition::PorePressure)
+        Kokkos::parallel_for(
+            "mupm::Fluid::mark", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+              if (mask == 0 || (regions(i) & mask))
+                fixed(i) |= kFixedPressure;
+            });
+      double v = 0;
+      Kokkos::parallel_reduce(
+          "mupm::Fluid::region_volume", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& s) {
+            if (mask == 0 || (regions(i) & mask))
+              s += vol(i);
+          },
+          v);
+      MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_SUM, comm_);
+      region_volume_[k] = v;
+    }
+    if (!restarted) {
+      set_pressure(t, p.p);
+      fluid_constitutive(p, prm_, st_);
+      auto pw = p.p, phi = p.porosity, sr = p.saturation, m = p.fluid_content;
+      auto vs = p.vol_strain, ref = p.vol_strain_ref;
+      const double inv_kw = 1.0 / prm_.bulk_modulus;
+      Kokkos::parallel_for(
+          "mupm::Fluid::content", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            m(i) = phi(i) * sr(i) * (1 + pw(i) * inv_kw);
+            ref(i) = vs(i);
+          });
+    }
+    evaluate();
+  }
+
+  void reset_strain_reference() {
+    auto& p = disc_.points;
+    Kokkos::deep_copy(Kokkos::subview(p.vol_strain_ref, std::make_pair(std::size_t(0), p.n_owned)),
+                      Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
+  }
+
+  // Advances p from t over `substeps` equal steps spanning dt_total, with the solid's volume
+  // change since the last update spread evenly over them.
+  void advance(double t, double dt_total, int substeps) {
+    ScopedRegion region("mupm::Fluid::advance");
+    const double dt = dt_total / substeps;
+    for (int k = 0; k < substeps; ++k)
+      substep(t + k * dt, dt, dt_total);
+    reset_strain_reference();
+  }
+
+  // Water mass in the body [kg]: rho_w sum_i V_i m_i.
+  double fluid_mass() const {
+    const auto& p = disc_.points;
+    auto m = p.fluid_content, vol = p.volume;
+    double s = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::mass", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += m(i) * vol(i); }, s);
+    MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return prm_.water_density * s;
+  }
+
+  // Largest S_r^2 / C over the points: the pore water's contribution to the undrained bulk
+  // modulus (K_w / phi when saturated), for the solid's stable step.
+  double undrained_stiffening() const {
+    const auto& p = disc_.points;
+    auto sr = p.saturation;
+    auto C = st_.storage;
+    double m = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::undrained", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          const double v = C(i) > 0 ? sr(i) * sr(i) / C(i) : 0.0;
+          acc = v > acc ? v : acc;
+        },
+        Kokkos::Max<double>(m));
+    MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    return m;
+  }
+
+  // Largest stable forward-Euler step 2 / lambda_max of C dp/dt = -L p (L: the flow operator at
+  // the current k_r and C, prescribed pressures held), by power iteration with the
+  // C-weighted Rayleigh quotient (from below).
+  double estimate_stable_dt(int iterations = 40) {
+    ScopedRegion region("mupm::Fluid::stable_step");
+    auto& p = disc_.points;
+    Scalars x("mupm::fluid_power_iterate", p.size());
+    auto gid = p.gid;
+    auto fixed = p.fixed;
+    Kokkos::parallel_for(
+        "mupm::Fluid::stable_step_start", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          x(i) = (fixed(i) & kFixedPressure) ? 0.0 : std::sin(1.3 * double(gid(i))) + 0.1;
+        });
+    double lambda = 0;
+    for (int it = 0; it < iterations; ++it) {
+      disc_.dist.refresh({as_vectors(x)});
+      fluid_flow(p, disc_.bonds, prm_, st_, disc_.dist, x, false);
+      auto flow = st_.flow, C = st_.storage, vol = p.volume;
+      double s[3] = {0, 0, 0};  // x.Lx, x.Cx, |C^-1 L x|_C^2
+      Kokkos::parallel_reduce(
+          "mupm::Fluid::stable_step_rayleigh", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& lx, double& cx, double& yy) {
+            if ((fixed(i) & kFixedPressure) || !(C(i) > 0))
+              return;
+            lx += x(i) * flow(i) * vol(i);
+            cx += C(i) * x(i) * x(i) * vol(i);
+            yy += flow(i) * flow(i) / C(i) * vol(i);
+          },
+          s[0], s[1], s[2]);
+      MPI_Allreduce(MPI_IN_PLACE, s, 3, MPI_DOUBLE, MPI_SUM, comm_);
+      lambda = s[1] > 0 ? s[0] / s[1] : 0.0;
+      const double norm = s[2] > 0 ? 1.0 / std::sqrt(s[2]) : 0.0;
+      Kokkos::parallel_for(
+          "mupm::Fluid::stable_step_next", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            x(i) = ((fixed(i) & kFixedPressure) || !(C(i) > 0)) ? 0.0 : flow(i) / C(i) * norm;
+          });
+    }
+    evaluate();
+    return lambda > 0 ? 2.0 / lambda : 0.0;
+  }
+
+ private:
+  // S_r, k_r, C and the flow of the current pressure (ghosts refreshed).
+  void evaluate() {
+    auto& p = disc_.points;
+    fluid_constitutive(p, prm_, st_);
+    disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation), as_vectors(p.rel_perm)});
+    fluid_flow(p, disc_.bonds, prm_, st_, disc_.dist, p.p);
+  }
+
+  // p = value g(t) on the points of every pressure condition (later conditions win).
+  void set_pressure(double t, const Scalars& target) {
+    auto& p = disc_.points;
+    auto regions = p.regions;
+    for (const auto& bc : bcs_) {
+      if (bc.kind != BoundaryCondition::PorePressure)
+        continue;
+      const std::uint32_t mask = bc.region_mask;
+      const double v = bc.value * bc.time(t);
+      Kokkos::parallel_for(
+          "mupm::Fluid::pressure_bc", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            if (mask == 0 || (regions(i) & mask))
+              target(i) = v;
+          });
+    }
+  }
+
+  // One forward-Euler step from t to t + dt (eqs 141-146). evaluate() has run for the state at t.
+  void substep(double t, double dt, double dt_total) {
+    auto& p = disc_.points;
+    const double h = Dim == 2 ? disc_.grid.thickness : 1.0;
+    auto regions = p.regions;
+    // Sources [1/s]: rate g(t) (per metre of thickness in 2D) over the region's volume.
+    Kokkos::deep_copy(source_, 0.0);
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      const auto& bc = bcs_[k];
+      if (bc.kind != BoundaryCondition::FluidSource || !(region_volume_[k] > 0))
+        continue;
+      const std::uint32_t mask = bc.region_mask;
+      const double s = bc.value * bc.time(t) * h / region_volume_[k];
+      auto src = source_;
+      Kokkos::parallel_for(
+          "mupm::Fluid::source", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            if (mask == 0 || (regions(i) & mask))
+              src(i) += s;
+          });
+      inflow_[k] += prm_.water_density * bc.value * bc.time(t) * h * dt;
+    }
+    // Prescribed pressures at t + dt go to supply_ first (the target), then the update.
+    auto target = supply_;
+    Kokkos::deep_copy(target, 0.0);
+    set_pressure(t + dt, target);
+    auto pw = p.p, rate = p.p_rate, sr = p.saturation, m = p.fluid_content, vol = p.volume;
+    auto vs = p.vol_strain, ref = p.vol_strain_ref;
+    auto fixed = p.fixed;
+    auto C = st_.storage, flow = st_.flow, src = source_;
+    const double inv_total = 1.0 / dt_total;
+    Kokkos::parallel_for(
+        "mupm::Fluid::update", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          const double dv = (vs(i) - ref(i)) * inv_total * dt;  // eq 117 over this step
+          const double rhs = -sr(i) * dv + dt * (src(i) - flow(i));
+          double dp;
+          if (fixed(i) & kFixedPressure) {
+            dp = target(i) - pw(i);
+            target(i) = vol(i) * (C(i) * dp - rhs);  // what the reservoir supplies [m^3]
+          } else {
+            dp = C(i) > 0 ? rhs / C(i) : 0.0;  // eq 143
+            target(i) = 0;
+          }
+          m(i) += C(i) * dp + sr(i) * dv;
+          rate(i) = dp / dt;
+          pw(i) += dp;  // eq 145, beta_3 = 0
+        });
+    std::vector<double> supplied(bcs_.size(), 0.0);
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      if (bcs_[k].kind != BoundaryCondition::PorePressure)
+        continue;
+      // Points of several pressure conditions count for the last one (set_pressure's order).
+      std::uint32_t later = 0;
+      bool later_all = false;
+      for (std::size_t l = k + 1; l < bcs_.size(); ++l)
+        if (bcs_[l].kind == BoundaryCondition::PorePressure) {
+          later |= bcs_[l].region_mask;
+          later_all = later_all || bcs_[l].region_mask == 0;
+        }
+      if (later_all)
+        continue;
+      const std::uint32_t mask = bcs_[k].region_mask;
+      double s = 0;
+      Kokkos::parallel_reduce(
+          "mupm::Fluid::inflow", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+            if ((mask == 0 || (regions(i) & mask)) && !(regions(i) & later))
+              acc += target(i);
+          },
+          s);
+      supplied[k] = s;
+    }
+    if (!supplied.empty())  // one reduction for all conditions
+      MPI_Allreduce(MPI_IN_PLACE, supplied.data(), int(supplied.size()), MPI_DOUBLE, MPI_SUM,
+                    comm_);
+    for (std::size_t k = 0; k < bcs_.size(); ++k)
+      inflow_[k] += prm_.water_density * supplied[k];
+    evaluate();
+  }
+
+  Discretization<Dim>& disc_;
+  FluidParams prm_;
+  MPI_Comm comm_;
+  std::vector<BoundaryCondition> bcs_;
+  FluidState<Dim> st_;
+  Scalars source_, supply_;
+  std::vector<double> inflow_, region_volume_;
+};
+
+}  // namespace mupm
+
+#endif
