@@ -612,8 +612,10 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     if (rank == 0) {
       out << "mupm: micropolar solid, stabilization G = " << prm.stabilization
           << ", D = " << prm.stab_modulus << " Pa/m^2; estimated stable dt = " << stable << " s"
-          << (fluid ? " (undrained, pore water adds " + std::to_string(stiffening) + " Pa)" : "")
-          << "; dt = " << dt << " s\n";
+          << (fluid ? " (undrained: the pore water adds up to " : "");
+      if (fluid)
+        out << stiffening << " Pa to the bulk modulus)";
+      out << "; dt = " << dt << " s\n";
       if (dt > safety * stable)
         out << "mupm: WARNING: Solver->Time Step = " << dt << " s exceeds "
             << "Time Step Safety Factor x the estimated stable step = " << safety * stable

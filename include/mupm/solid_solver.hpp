@@ -52,6 +52,7 @@ class SolidSolver {
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
+    pstar_old_ = Scalars("mupm::solid_pore_pressure_old", p.n_owned);
   }
 
   const SolidState<Dim>& state() const { return st_; }
@@ -108,6 +109,7 @@ class SolidSolver {
     double w[3] = {0.5 * power(), 0, 0};  // old forces on the increment (trapezoid, first half)
     Kokkos::deep_copy(vs_old_,
                       Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
+    Kokkos::deep_copy(pstar_old_, st_.pstar);
     forces(t + dt);
     w[0] += 0.5 * power();  // new forces (second half)
     w[1] = dt * damping_power();
@@ -271,18 +273,19 @@ class SolidSolver {
   }
 
   // sum_i V_i S_r (p*_old + p*_new)/2 (tr eps_new - tr eps_old) of this step (this rank's
-  // points; step() sums over ranks).
+  // points; step() sums over ranks), with the p* the forces were evaluated with: the old one
+  // is from before any fluid update in between, as the first half of the velocity update
+  // used it (trapezoid rule on the applied forces, like the external work).
   double pore_power() const {
     const auto& p = disc_.points;
-    auto vs = p.vol_strain, sr = p.saturation, pw = p.p, vol = p.volume;
-    auto bu = p.undrained_modulus, ref = p.vol_strain_ref;
+    auto vs = p.vol_strain, sr = p.saturation, vol = p.volume;
+    auto ps = st_.pstar, ps_old = pstar_old_;
     auto old = vs_old_;
     double w = 0;
     Kokkos::parallel_reduce(
         "mupm::Solid::pore_work", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& acc) {
-          const double p_mid = pw(i) - bu(i) * (0.5 * (vs(i) + old(i)) - ref(i));
-          acc += vol(i) * sr(i) * p_mid * (vs(i) - old(i));
+          acc += vol(i) * sr(i) * 0.5 * (ps(i) + ps_old(i)) * (vs(i) - old(i));
         },
         w);
     return w;
@@ -333,7 +336,7 @@ class SolidSolver {
         w);
     return w;
   }
-  // Damping power c (rho v.v + J omega.omega) V at the half step.
+  // Damping power c (rho v.v + J omega.omega) V at the half step (this rank's points).
   double damping_power() const {
     if (set_.damping == 0)
       return 0.0;
@@ -366,7 +369,7 @@ class SolidSolver {
   SolidState<Dim> st_;
   Scalars rho_, inertia_;
   Vectors body_, couple_, du_;
-  Scalars vs_old_;
+  Scalars vs_old_, pstar_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0;
 };
 
