@@ -77,6 +77,7 @@ std::vector<NamedField> state_fields(const Points<Dim>& p) {
           {"volumetric_strain", as_vectors(p.vol_strain)},
           {"volumetric_strain_reference", as_vectors(p.vol_strain_ref)},
           {"fluid_content", as_vectors(p.fluid_content)},
+          {"solid_pressure", as_vectors(p.solid_pressure)},
           {"damage", as_vectors(p.damage)},
           {"stress", p.stress},
           {"couple_stress", p.couple_stress},

@@ -52,6 +52,7 @@ struct Points {
   Vectors darcy_flux;         // q [m/s] (eq 54) [n][Dim]
   Scalars vol_strain;         // tr(eps) of the solid (eq 117)
   Scalars vol_strain_ref;     // tr(eps) at the last fluid update
+  Scalars solid_pressure;     // p* of the solid's last force evaluation (undrained split)
   Scalars undrained_modulus;  // S_r / C [Pa]: dp = -(S_r/C) d(tr eps) at fixed water content;
                               // 0 where p is prescribed or without a fluid (undrained split)
   Scalars fluid_content;      // water volume per unit volume, phi S_r (1 + p/K_w) at t = 0 plus
@@ -95,6 +96,7 @@ struct Points {
     vol_strain_ref = Scalars("mupm::volumetric_strain_ref", n);
     fluid_content = Scalars("mupm::fluid_content", n);
     undrained_modulus = Scalars("mupm::undrained_modulus", n);
+    solid_pressure = Scalars("mupm::solid_pressure", n);
     damage = Scalars("mupm::damage", n);
     fracture = Bytes("mupm::fracture", n);
     stress = Vectors("mupm::stress", n, Dim * Dim);
@@ -105,7 +107,7 @@ struct Points {
   // Resident bytes of one point (all fields above).
   static constexpr std::size_t bytes_per_point() {
     return sizeof(GlobalId) + sizeof(double) * (Dim + 1) + 3 * sizeof(std::uint32_t) +
-           sizeof(double) * (3 * Dim + 3 * rot_dim + 4 + 2 + 1) + 1 + sizeof(double) * (Dim + 5) +
+           sizeof(double) * (3 * Dim + 3 * rot_dim + 4 + 2 + 1) + 1 + sizeof(double) * (Dim + 6) +
            sizeof(double) * (Dim * Dim + rot_dim * Dim + 1);
   }
 };

@@ -91,7 +91,14 @@ class SolidSolver {
     if (!restarted)
       apply_kinematic(bcs_, p, t, 0.0);
     disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
+    // A restart keeps the p* of the last force evaluation before the checkpoint (the pore work
+    // of the next step starts from it), not the one of the pressure the fluid has updated since.
+    Scalars kept("mupm::solid_pressure_kept", restarted ? p.size() : 0);
+    if (restarted)
+      Kokkos::deep_copy(kept, p.solid_pressure);
     forces(t);
+    if (restarted)
+      Kokkos::deep_copy(p.solid_pressure, kept);
     if (!restarted)
       advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                          0.0, 0.0);
@@ -109,7 +116,8 @@ class SolidSolver {
     double w[3] = {0.5 * power(), 0, 0};  // old forces on the increment (trapezoid, first half)
     Kokkos::deep_copy(vs_old_,
                       Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
-    Kokkos::deep_copy(pstar_old_, st_.pstar);
+    Kokkos::deep_copy(pstar_old_,
+                      Kokkos::subview(p.solid_pressure, std::make_pair(std::size_t(0), p.n_owned)));
     forces(t + dt);
     w[0] += 0.5 * power();  // new forces (second half)
     w[1] = dt * damping_power();
@@ -184,7 +192,7 @@ class SolidSolver {
   // Largest stable step of the undamped central difference, 2 / omega_max, with omega_max^2
   // the largest eigenvalue of M^-1 K of the discrete operator (prescribed components held),
   // by power iteration with the mass-weighted Rayleigh quotient (it approaches omega_max^2
-  // from below). The state is restored afterwards.
+  // from below). The state (and the p* of the last force evaluation) is restored afterwards.
   // With a fluid the operator includes the undrained stiffness S_r^2 / C of the undrained split
   // (include/mupm/solid.hpp): the fastest waves are the undrained ones.
   double estimate_stable_dt(int iterations = 40) {
@@ -194,9 +202,10 @@ class SolidSolver {
     Vectors u0("u0", n, Dim), t0("t0", n, R);
     Kokkos::deep_copy(u0, p.u);
     Kokkos::deep_copy(t0, p.theta);
-    Scalars p0("p0", n), ref0("ref0", n);
+    Scalars p0("p0", n), ref0("ref0", n), ps0("ps0", n);
     Kokkos::deep_copy(p0, p.p);
     Kokkos::deep_copy(ref0, p.vol_strain_ref);
+    Kokkos::deep_copy(ps0, p.solid_pressure);
     Kokkos::deep_copy(p.p, 0.0);  // the operator's linear part only
     Kokkos::deep_copy(p.vol_strain_ref, 0.0);
     auto u = p.u, th = p.theta, gid = p.gid;
@@ -252,6 +261,7 @@ class SolidSolver {
     Kokkos::deep_copy(p.vol_strain_ref, ref0);
     disc_.dist.refresh({p.u, p.theta});
     solid_forces(p, disc_.bonds, prm_, st_, disc_.dist);
+    Kokkos::deep_copy(p.solid_pressure, ps0);
     return lambda > 0 ? 2.0 / std::sqrt(lambda) : 0.0;
   }
 
@@ -279,7 +289,7 @@ class SolidSolver {
   double pore_power() const {
     const auto& p = disc_.points;
     auto vs = p.vol_strain, sr = p.saturation, vol = p.volume;
-    auto ps = st_.pstar, ps_old = pstar_old_;
+    auto ps = p.solid_pressure, ps_old = pstar_old_;
     auto old = vs_old_;
     double w = 0;
     Kokkos::parallel_reduce(
