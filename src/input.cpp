@@ -286,10 +286,17 @@ RCP<ParameterList> valid_parameters() {
           "relaxation; 0: none.",
           at_least(0.0));
     s.set("Energy Tolerance", 1e-2,
-          "Largest accepted |E_int + E_kin + D - W_ext - E_0| relative to the largest of those "
-          "terms (eqs 137-140); beyond it a warning with the step.",
+          "Largest accepted |E_int + E_kin + D - W_ext - W_pore - E_0| (solid, eqs 137-140) and "
+          "|E_s - E_s0 + W_c + D_f - W_ext,f| (fluid, eqs 147-149) relative to the largest of "
+          "their terms; beyond it a warning with the step.",
           at_least(0.0));
     s.set("Stop On Energy Violation", false, "Stop the run when the energy balance is violated.");
+    s.set("Energy Check Start", 20,
+          "Steps after the start (or a restart) before the energy balances are checked: in the "
+          "first steps from rest every term is tiny and the scheme's start-up error (forward "
+          "Euler weighs the first fluid step with p = 0; the first solid steps of a ramped load) "
+          "is of the same size as the terms.",
+          at_least(0));
     s.set("Number of Steps", 100, "Number of time steps (>= 0).", at_least(0));
     s.set("Restart From", std::string(""),
           "Checkpoint file (.h5) to continue from; empty: start at t = 0. The run may use a "

@@ -671,6 +671,9 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
       columns.push_back(r);
   }
   if (fluid) {
+    for (const char* c : {"fluid_stored_energy", "fluid_coupling_work", "fluid_dissipation",
+                          "fluid_external_work", "fluid_energy_error"})
+      columns.push_back(c);
     columns.push_back("fluid_mass");
     for (const auto& r : fluid_solver->inflow_names())
       columns.push_back(r);
@@ -684,7 +687,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     energy0 = solver_globals[solid_globals - 1];
   const double energy_tol = solver.get<double>("Energy Tolerance");
   const bool energy_stop = solver.get<bool>("Stop On Energy Violation");
-  long long energy_warnings = 0;
+  long long energy_warnings = 0, fluid_energy_warnings = 0;
+  const long long energy_skip = solver.get<int>("Energy Check Start");
   auto solver_state = [&] {
     auto g = solid ? solid_solver->globals() : std::vector<double>{};
     if (solid)
@@ -734,6 +738,10 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
         row.push_back(r);
     }
     if (fluid) {
+      const auto e = fluid_solver->energy();
+      for (double v :
+           {e.stored - e.stored0, e.coupling_work, e.dissipation, e.external_work, e.balance()})
+        row.push_back(v);
       row.push_back(fluid_solver->fluid_mass());
       for (double r : fluid_solver->inflows())
         row.push_back(r);
@@ -770,20 +778,29 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     }
     ++step;
     time += dt;
+    // Energy balances (eqs 140 and 149): warn, or stop, beyond the tolerance.
+    auto check_balance = [&](const char* what, double err, double scale, long long& warnings) {
+      if (step - first_step <= energy_skip || !(err > energy_tol * scale && scale > 0))
+        return;
+      std::ostringstream s;
+      s << what << " energy balance violated at step " << step << " (t = " << time << " s): |"
+        << (what[0] == 's' ? "E_int + E_kin + D - W_ext - W_pore - E_0"
+                           : "E_s - E_s0 + W_c + D - W_ext")
+        << "| = " << err << " J is " << err / scale
+        << " of the largest term (Solver->Energy Tolerance = " << energy_tol << ")";
+      if (energy_stop)
+        throw CollectiveError("Error, " + s.str() + ".");
+      if (rank == 0 && (warnings < 5 || warnings % 1000 == 0))
+        out << "mupm: WARNING: " << s.str() << "\n";
+      ++warnings;
+    };
     if (solid) {
       const auto e = solid_solver->energy();
-      const double err = std::abs(e.balance() - energy0);
-      if (err > energy_tol * e.scale() && e.scale() > 0) {
-        std::ostringstream s;
-        s << "energy balance violated at step " << step << " (t = " << time
-          << " s): |E_int + E_kin + D - W_ext - E_0| = " << err << " J is " << err / e.scale()
-          << " of the largest term (Solver->Energy Tolerance = " << energy_tol << ")";
-        if (energy_stop)
-          throw CollectiveError("Error, " + s.str() + ".");
-        if (rank == 0 && (energy_warnings < 5 || energy_warnings % 1000 == 0))
-          out << "mupm: WARNING: " << s.str() << "\n";
-        ++energy_warnings;
-      }
+      check_balance("solid", std::abs(e.balance() - energy0), e.scale(), energy_warnings);
+    }
+    if (fluid) {
+      const auto e = fluid_solver->energy();
+      check_balance("fluid", std::abs(e.balance()), e.scale(), fluid_energy_warnings);
     }
     if (check_finite) {
       GlobalId bad = non_finite_point(pts);

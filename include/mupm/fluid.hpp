@@ -89,6 +89,28 @@ struct FluidState {
   std::vector<Vectors> pass2_ghosts() const { return {grad, qk, as_vectors(alpha)}; }
 };
 
+// Energy stored in the pore water per unit volume, psi(p) = int_0^p C(q) q dq (the work of
+// the pressure on the water content, dm = C dp): phi p^2 / (2 K_w) for p >= 0, and for p < 0
+// (unsaturated) the capillary part phi int q dS_r plus the compressional part, by 8-point
+// Gauss-Legendre quadrature on [p, 0]. A state function: the fluid energy balance (eqs
+// 147-149) compares its change with the power the update books step by step.
+KOKKOS_INLINE_FUNCTION double stored_energy_density(const VanGenuchten& vg, double phi,
+                                                    double inv_kw, double p) {
+  if (p >= 0 || !vg.enabled)
+    return 0.5 * phi * inv_kw * p * p;
+  const double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                       0.9602898564975363};
+  const double w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                       0.1012285362903763};
+  double s = 0;
+  for (int k = 0; k < 4; ++k)
+    for (int sign = -1; sign <= 1; sign += 2) {
+      const double q = 0.5 * p * (1 + sign * x[k]);  // nodes on [p, 0]
+      s += w[k] * phi * (vg.dsaturation_dp(q) + vg.saturation(q) * inv_kw) * q;
+    }
+  return 0.5 * p * s;  // int_0^p f dq = (p/2) sum_k w_k f(q_k), q_k the nodes on [p, 0]
+}
+
 // Saturation (eq 12), relative permeability (eq 56), storage C and the undrained modulus
 // S_r / C (for the solid's undrained split, include/mupm/solid.hpp) of the owned points.
 template <int Dim>

@@ -15,6 +15,18 @@
 // and sum_i V_i div_i = 0 (each bond's flow appears with both signs), so
 //   rho_w sum_i V_i m_i (t) - rho_w sum_i V_i m_i (0) = inflow through pressure conditions +
 //   injected water, to round-off. The test FluidSolver.MassConservation checks both.
+//
+// Energy (eqs 147-149, in power form): multiplying the mass balance by p gives
+//   d/dt sum V psi(p) = -sum V S_r p dV_s/dt - sum V p div + sum V p s + sum p supply,
+// psi the stored energy density (include/mupm/fluid.hpp). The update books the flow
+// dissipation D and the external work W_ext (sources and reservoirs) with the pressure at the
+// start of each step (the rate forward Euler uses), and the coupling work W_c (the water's
+// work on the skeleton) with the step's mean pressure (the undrained response to a volume
+// change is exact, not a forward-Euler rate). With constant C the balance
+// E_s(t) - E_s(0) + W_c + D - W_ext then differs from zero by sum V dp dt (s - div) / 2 per
+// step: the forward-Euler error of the flow alone, first order in dt for a smooth evolution and
+// growing without bound when the step is unstable. The driver checks it against
+// Solver->Energy Tolerance like the solid's (eq 149).
 #ifndef MUPM_FLUID_SOLVER_HPP
 #define MUPM_FLUID_SOLVER_HPP
 
@@ -50,11 +62,40 @@ class FluidSolver {
   const FluidState<Dim>& state() const { return st_; }
   const FluidParams& params() const { return prm_; }
 
-  // Cumulative water mass [kg] that entered through each fluid condition (for restarts).
-  std::vector<double> globals() const { return inflow_; }
+  struct Energy {
+    double stored = 0, stored0 = 0, coupling_work = 0, dissipation = 0, external_work = 0;
+    double balance() const {
+      return stored - stored0 + coupling_work + dissipation - external_work;
+    }
+    double scale() const {
+      return std::max(std::max(std::abs(stored - stored0), std::abs(coupling_work)),
+                      std::max(std::abs(dissipation), std::abs(external_work)));
+    }
+  };
+  Energy energy() const {
+    Energy e = energy_;
+    e.stored = stored_energy();
+    return e;
+  }
+
+  // For restarts: the cumulative water mass [kg] that entered through each fluid condition,
+  // then the energy terms booked so far.
+  std::vector<double> globals() const {
+    auto g = inflow_;
+    for (double v :
+         {energy_.stored0, energy_.coupling_work, energy_.dissipation, energy_.external_work})
+      g.push_back(v);
+    return g;
+  }
   void set_globals(const std::vector<double>& g) {
-    if (g.size() >= inflow_.size())
-      std::copy(g.begin(), g.begin() + long(inflow_.size()), inflow_.begin());
+    if (g.size() < inflow_.size() + 4)
+      return;
+    std::copy(g.begin(), g.begin() + long(inflow_.size()), inflow_.begin());
+    const double* e = g.data() + inflow_.size();
+    energy_.stored0 = e[0];
+    energy_.coupling_work = e[1];
+    energy_.dissipation = e[2];
+    energy_.external_work = e[3];
   }
   std::vector<std::string> inflow_names() const {
     std::vector<std::string> n;
@@ -92,6 +133,7 @@ class FluidSolver {
     }
     if (!restarted) {
       set_pressure(t, p.p);
+      energy_.stored0 = stored_energy();
       fluid_constitutive(p, prm_, st_);
       auto pw = p.p, phi = p.porosity, sr = p.saturation, m = p.fluid_content;
       auto vs = p.vol_strain, ref = p.vol_strain_ref;
@@ -131,6 +173,23 @@ class FluidSolver {
         KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += m(i) * vol(i); }, s);
     MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
     return prm_.water_density * s;
+  }
+
+  // sum_i V_i psi(p_i) [J].
+  double stored_energy() const {
+    const auto& p = disc_.points;
+    auto pw = p.p, phi = p.porosity, vol = p.volume;
+    const VanGenuchten vg = prm_.retention;
+    const double inv_kw = 1.0 / prm_.bulk_modulus;
+    double s = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::stored_energy", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          acc += vol(i) * stored_energy_density(vg, phi(i), inv_kw, pw(i));
+        },
+        s);
+    MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return s;
   }
 
   // Largest S_r^2 / C over the points: the pore water's contribution to the undrained bulk
@@ -248,23 +307,33 @@ class FluidSolver {
     auto fixed = p.fixed;
     auto C = st_.storage, flow = st_.flow, src = source_;
     const double inv_total = 1.0 / dt_total;
-    Kokkos::parallel_for(
-        "mupm::Fluid::update", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+    double w[3] = {0, 0, 0};  // coupling work, flow dissipation, external work (energy_ doc)
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::update", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& wc, double& wd, double& we) {
           const double dv = (vs(i) - ref(i)) * inv_total * dt;  // eq 117 over this step
           const double rhs = -sr(i) * dv + dt * (src(i) - flow(i));
           double dp;
+          const double p0 = pw(i);
           if (fixed(i) & kFixedPressure) {
-            dp = target(i) - pw(i);
+            dp = target(i) - p0;
             target(i) = vol(i) * (C(i) * dp - rhs);  // what the reservoir supplies [m^3]
           } else {
             dp = C(i) > 0 ? rhs / C(i) : 0.0;  // eq 143
             target(i) = 0;
           }
+          wc += vol(i) * (p0 + 0.5 * dp) * sr(i) * dv;
+          wd += vol(i) * p0 * dt * flow(i);
+          we += vol(i) * p0 * dt * src(i) + p0 * target(i);
           m(i) += C(i) * dp + sr(i) * dv;
           rate(i) = dp / dt;
-          pw(i) += dp;  // eq 145, beta_3 = 0
-        });
-    std::vector<double> supplied(bcs_.size(), 0.0);
+          pw(i) = p0 + dp;  // eq 145, beta_3 = 0
+        },
+        w[0], w[1], w[2]);
+    std::vector<double> supplied(bcs_.size() + 3, 0.0);
+    supplied[bcs_.size()] = w[0];
+    supplied[bcs_.size() + 1] = w[1];
+    supplied[bcs_.size() + 2] = w[2];
     for (std::size_t k = 0; k < bcs_.size(); ++k) {
       if (bcs_[k].kind != BoundaryCondition::PorePressure)
         continue;
@@ -289,11 +358,13 @@ class FluidSolver {
           s);
       supplied[k] = s;
     }
-    if (!supplied.empty())  // one reduction for all conditions
-      MPI_Allreduce(MPI_IN_PLACE, supplied.data(), int(supplied.size()), MPI_DOUBLE, MPI_SUM,
-                    comm_);
+    // One reduction for all conditions and the energy terms.
+    MPI_Allreduce(MPI_IN_PLACE, supplied.data(), int(supplied.size()), MPI_DOUBLE, MPI_SUM, comm_);
     for (std::size_t k = 0; k < bcs_.size(); ++k)
       inflow_[k] += prm_.water_density * supplied[k];
+    energy_.coupling_work += supplied[bcs_.size()];
+    energy_.dissipation += supplied[bcs_.size() + 1];
+    energy_.external_work += supplied[bcs_.size() + 2];
     evaluate();
   }
 
@@ -304,6 +375,7 @@ class FluidSolver {
   FluidState<Dim> st_;
   Scalars source_, supply_;
   std::vector<double> inflow_, region_volume_;
+  Energy energy_;
 };
 
 }  // namespace mupm
