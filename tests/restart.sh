@@ -50,5 +50,5 @@ with h5py.File(f"{name}-straight/checkpoint.h5") as a, h5py.File(f"{name}-second
 PY
 }
 check solid quickstart.xml 40 4
-check coupled consolidation.xml 60 6
+check coupled consolidation.xml 60 10
 echo "restart: passed"

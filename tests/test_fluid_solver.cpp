@@ -156,8 +156,9 @@ TEST(FluidSolver, EnergyBalanceFlagsInstability) {
           "%.4g J, |balance| / largest = %.3g (flagged at step %d)\n",
           k == 0 ? "0.5" : "1.1", e.stored - e.stored0, e.dissipation, e.external_work, relative[k],
           flagged);
-    if (k == 0)
+    if (k == 0) {
       EXPECT_GT(e.dissipation, 0.0);
+    }
   }
   EXPECT_LT(relative[0], 1e-2);
   EXPECT_FALSE(relative[1] < 1e-2);
