@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <functional>
 
+#include "mupm/simulation.hpp"
 #include "mupm/staggered.hpp"
 #include "test_utils.hpp"
 
@@ -592,6 +593,43 @@ TEST(FluidSolver, MassConservation3D) {
     fluid.advance(s * dt, dt, 1);
   EXPECT_NEAR(fluid.fluid_mass(), m0, 1e-13 * m0);
   EXPECT_LT(spread(), 0.5 * s0);
+}
+
+}  // namespace
+}  // namespace mupm
+
+namespace mupm {
+namespace {
+
+// Initial condition "Hydrostatic Pore Pressure": p = rho_w g.(x - x0) (x0 on the water table),
+// which Darcy's law with gravity leaves at rest: unsaturated above the table, saturated below,
+// nothing flows and p stays put.
+TEST(FluidSolver, HydrostaticInitialStateStaysAtRest) {
+  auto g = test::box<2>({6, 20}, 3.015, 0.01);
+  auto disc = discretize(test::world(), g);
+  Kokkos::deep_copy(disc.points.porosity, 0.3);
+  InitialCondition ic;
+  ic.field = "Hydrostatic Pore Pressure";
+  ic.value = {0.0, 0.12};  // water table at y = 0.12 m
+  apply_initial_conditions<2>({ic}, disc.points, {0.0, 1000 * -9.81, 0.0});
+  auto prm = fluid_params(g, 1e-10, 0.5);
+  prm.retention = VanGenuchten::mualem(1e3, 2.0);
+  prm.gravity[1] = -9.81;
+  FluidSolver<2> fluid(disc, prm, {}, MPI_COMM_WORLD);
+  fluid.initialize(0, false);
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.x);
+  auto p0 = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.p);
+  for (std::size_t i = 0; i < disc.points.n_owned; ++i)
+    EXPECT_NEAR(p0(i), 1000 * 9.81 * (0.12 - x(i, 1)), 1e-9);
+  const double dt = 0.5 * fluid.estimate_stable_dt();
+  for (int s = 0; s < 50; ++s)
+    fluid.advance(s * dt, dt, 1);
+  auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.p);
+  auto q = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.darcy_flux);
+  for (std::size_t i = 0; i < disc.points.n_owned; ++i) {
+    EXPECT_NEAR(p(i), p0(i), 1e-9 * 1000 * 9.81 * 0.2);
+    EXPECT_NEAR(q(i, 1), 0.0, 1e-9 * 1e-10 * 1000 * 9.81);
+  }
 }
 
 }  // namespace
