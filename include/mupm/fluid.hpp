@@ -49,7 +49,7 @@
 #include "mupm/bonds.hpp"
 #include "mupm/distribution.hpp"
 #include "mupm/points.hpp"
-#include "mupm/small_matrix.hpp"
+#include "mupm/shape_tensor.hpp"
 #include "mupm/unsaturated.hpp"
 
 namespace mupm {
@@ -135,7 +135,8 @@ void fluid_constitutive(const Points<Dim>& pts, const FluidParams& prm, FluidSta
 // Pass 1 (per owned point): grad p, Darcy flux q (into pts.darcy_flux), K^-1 q, alpha.
 // `p` is the pressure field (owned + ghosts current); `with_gravity` false drops rho_w g (the
 // stable-step estimate uses the linear operator only). Points whose K is singular (see
-// include/mupm/solid.hpp) get grad p = 0, q = 0: their bonds carry the stabilization flow only.
+// invert_shape_tensor, include/mupm/shape_tensor.hpp) get grad p = 0, q = 0: their bonds carry the
+// stabilization flow only.
 template <int Dim>
 void fluid_pass1(const Points<Dim>& pts, const Bonds& bonds, const FluidParams& prm,
                  FluidState<Dim>& st, const Scalars& p, bool with_gravity = true) {
@@ -172,15 +173,8 @@ void fluid_pass1(const Points<Dim>& pts, const Bonds& bonds, const FluidParams& 
           }
           wsum += vj;
         }
-        double tr = 0;
-        for (int d = 0; d < Dim; ++d)
-          tr += K[d * Dim + d];
         double Kinv[Dim * Dim] = {};
-        const double det = tr > 0 ? invert<Dim>(K, Kinv) : 0.0;
-        double scale = tr / Dim;
-        for (int d = 1; d < Dim; ++d)
-          scale *= tr / Dim;
-        const bool singular = !(tr > 0) || !(det > 1e-6 * scale);
+        const bool singular = !invert_shape_tensor<Dim>(K, Kinv);
         const double lambda = kr(i) * k0;
         double gp[Dim] = {}, qi[Dim] = {}, qki[Dim] = {};
         if (!singular) {

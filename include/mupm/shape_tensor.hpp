@@ -6,8 +6,28 @@
 
 #include "mupm/bonds.hpp"
 #include "mupm/points.hpp"
+#include "mupm/small_matrix.hpp"
 
 namespace mupm {
+
+// K^-1 of a point's shape tensor, or false (and K^-1 = 0) when K is singular: no intact bond
+// (trace 0) or det K below 1e-6 of the determinant (tr K / Dim)^Dim of a well-conditioned K of
+// the same trace. Pass 1 of the solid and of the fluid treat such a point as degenerate.
+template <int Dim>
+KOKKOS_INLINE_FUNCTION bool invert_shape_tensor(const double* K, double* Kinv) {
+  double tr = 0;
+  for (int d = 0; d < Dim; ++d)
+    tr += K[d * Dim + d];
+  const double det = tr > 0 ? invert<Dim>(K, Kinv) : 0.0;
+  double scale = tr / Dim;
+  for (int d = 1; d < Dim; ++d)
+    scale *= tr / Dim;
+  if (tr > 0 && det > 1e-6 * scale)
+    return true;
+  for (int k = 0; k < Dim * Dim; ++k)
+    Kinv[k] = 0;
+  return false;
+}
 
 // Fills K [n_owned][Dim*Dim] (row-major) for the owned points.
 template <int Dim>

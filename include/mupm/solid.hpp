@@ -42,7 +42,7 @@
 #include "mupm/distribution.hpp"
 #include "mupm/micropolar_elastic.hpp"
 #include "mupm/points.hpp"
-#include "mupm/small_matrix.hpp"
+#include "mupm/shape_tensor.hpp"
 
 namespace mupm {
 
@@ -169,21 +169,9 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
               B[r * Dim + k] += om[r] * xi[k] * vj;  // eq 51
           wsum += vj;
         }
-        double tr = 0;
-        for (int d = 0; d < Dim; ++d)
-          tr += K[d * Dim + d];
         double Kinv[Dim * Dim] = {}, eps[Dim * Dim] = {}, kap[R * Dim] = {};
-        double det = 0;
-        if (tr > 0)
-          det = invert<Dim>(K, Kinv);
-        double scale = tr / Dim;
-        for (int d = 1; d < Dim; ++d)
-          scale *= tr / Dim;
-        const bool singular = !(tr > 0) || !(det > 1e-6 * scale);
-        if (singular) {
-          for (int k = 0; k < Dim * Dim; ++k)
-            Kinv[k] = 0;
-        } else {
+        const bool singular = !invert_shape_tensor<Dim>(K, Kinv);
+        if (!singular) {
           mat_mul<Dim, Dim>(A, Kinv, eps);
           mat_mul<R, Dim>(B, Kinv, kap);
         }
