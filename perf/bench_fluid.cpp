@@ -19,8 +19,7 @@ FluidParams fluid_params(const GridSpec<Dim>& g) {
   FluidParams f;
   f.mobility = 1e-10;
   f.retention = VanGenuchten::mualem(10e3, 2.0);  // unsaturated: every retention branch runs
-  f.horizon_volume = Dim == 2 ? kPi * g.horizon * g.horizon * g.thickness
-                              : 4.0 / 3.0 * kPi * std::pow(g.horizon, 3);
+  f.horizon_volume = g.family_volume();
   f.second_moment = family_second_moment<Dim>(g.horizon, g.thickness);
   return f;
 }

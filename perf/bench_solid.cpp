@@ -32,8 +32,7 @@ struct Body {
     prm.stabilization = 0.5;
     prm.stab_modulus =
         stabilization_modulus<Dim>(kLaw, g.horizon, g.thickness, StabilizationModulus::Automatic);
-    prm.horizon_volume = Dim == 2 ? kPi * g.horizon * g.horizon * g.thickness
-                                  : 4.0 / 3.0 * kPi * std::pow(g.horizon, 3);
+    prm.horizon_volume = g.family_volume();
     st.allocate(disc.points.size(), disc.points.n_owned);
     set_field();
     // Pass 2 reads pass 1's outputs: run the whole evaluation once so that pass 2 alone sees

@@ -571,8 +571,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
         fp.retention.m = m;
     }
     fp.stabilization = fluid_input.get<double>("Flow Stabilization");
-    fp.horizon_volume = Dim == 2 ? kPi * grid.horizon * grid.horizon * grid.thickness
-                                 : 4.0 / 3.0 * kPi * std::pow(grid.horizon, 3);
+    fp.horizon_volume = grid.family_volume();
     fp.second_moment = family_second_moment<Dim>(grid.horizon, grid.thickness);
     if (fluid_input.get<bool>("Gravity In Darcy Flux"))
       fp.gravity = gravity;
@@ -594,8 +593,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
                                    sm == "Eq 71"           ? StabilizationModulus::Eq71
                                    : sm == "Bulk Matching" ? StabilizationModulus::BulkMatching
                                                            : StabilizationModulus::Automatic);
-    prm.horizon_volume = Dim == 2 ? kPi * grid.horizon * grid.horizon * grid.thickness
-                                  : 4.0 / 3.0 * kPi * std::pow(grid.horizon, 3);
+    prm.horizon_volume = grid.family_volume();
     typename SolidSolver<Dim>::Settings settings;
     settings.rho_s = materials.get<double>("Solid Density");
     settings.rho_w = rho_w;

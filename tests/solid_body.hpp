@@ -24,8 +24,7 @@ struct Body {
     prm.law = law;
     prm.stabilization = G;
     prm.stab_modulus = stabilization_modulus<Dim>(law, g.horizon, g.thickness, choice);
-    prm.horizon_volume = Dim == 2 ? kPi * g.horizon * g.horizon * g.thickness
-                                  : 4.0 / 3.0 * kPi * std::pow(g.horizon, 3);
+    prm.horizon_volume = g.family_volume();
     st.allocate(disc.points.size(), disc.points.n_owned);
     rho = Scalars("rho", disc.points.n_owned);
     inertia = Scalars("J", disc.points.n_owned);

@@ -58,8 +58,7 @@ struct FluidBody {
   FluidBody(const GridSpec<Dim>& g, double G) : disc(discretize(test::world(), g)) {
     prm.mobility = 2e-9;
     prm.stabilization = G;
-    prm.horizon_volume = Dim == 2 ? kPi * g.horizon * g.horizon * g.thickness
-                                  : 4.0 / 3.0 * kPi * std::pow(g.horizon, 3);
+    prm.horizon_volume = g.family_volume();
     prm.second_moment = family_second_moment<Dim>(g.horizon, g.thickness);
     st.allocate(disc.points.size(), disc.points.n_owned);
     Kokkos::deep_copy(disc.points.porosity, 0.3);

@@ -29,8 +29,7 @@ FluidParams fluid_params(const GridSpec<Dim>& g, double mobility, double G) {
   FluidParams f;
   f.mobility = mobility;
   f.stabilization = G;
-  f.horizon_volume = Dim == 2 ? kPi * g.horizon * g.horizon * g.thickness
-                              : 4.0 / 3.0 * kPi * std::pow(g.horizon, 3);
+  f.horizon_volume = g.family_volume();
   f.second_moment = family_second_moment<Dim>(g.horizon, g.thickness);
   return f;
 }
@@ -345,7 +344,7 @@ struct ColumnRun {
     sp.stabilization = 0.5;
     sp.stab_modulus =
         stabilization_modulus<2>(tz.law, g.horizon, g.thickness, StabilizationModulus::Automatic);
-    sp.horizon_volume = kPi * g.horizon * g.horizon * g.thickness;
+    sp.horizon_volume = g.family_volume();
     SolidSolver<2>::Settings set;
     set.rho_s = tz.rho_s;
     set.rho_w = tz.rho_w;

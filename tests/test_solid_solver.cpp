@@ -17,7 +17,7 @@ SolidParams params(const MicropolarElastic& law, const GridSpec<2>& g) {
   prm.stabilization = 0.5;
   prm.stab_modulus =
       stabilization_modulus<2>(law, g.horizon, g.thickness, StabilizationModulus::Automatic);
-  prm.horizon_volume = kPi * g.horizon * g.horizon * g.thickness;
+  prm.horizon_volume = g.family_volume();
   return prm;
 }
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,10 @@ struct GridSpec {
     for (int d = 0; d < Dim; ++d)
       n *= lattice_count(d);
     return n;
+  }
+  // Volume V_H of a full continuous family: pi delta^2 h (2D), 4/3 pi delta^3 (3D).
+  double family_volume() const {
+    return Dim == 2 ? kPi * horizon * horizon * thickness : 4.0 / 3.0 * kPi * std::pow(horizon, 3);
   }
   double point_volume() const {
     double v = Dim == 2 ? thickness : 1.0;
