@@ -52,7 +52,7 @@ struct Points {
   Vectors darcy_flux;         // q [m/s] (eq 54) [n][Dim]
   Scalars vol_strain;         // tr(eps) of the solid (eq 117)
   Scalars vol_strain_ref;     // tr(eps) at the last fluid update
-  Scalars solid_pressure;     // p* of the solid's last force evaluation (undrained split)
+  Scalars solid_pressure;     // p* of the forces the solid last applied (undrained split)
   Scalars undrained_modulus;  // S_r / C [Pa]: dp = -(S_r/C) d(tr eps) at fixed water content;
                               // 0 where p is prescribed or without a fluid (undrained split)
   Scalars fluid_content;      // water volume per unit volume, phi S_r (1 + p/K_w) at t = 0 plus

@@ -89,6 +89,7 @@ struct SolidState {
   Vectors force;       // force density f_i [n_owned][Dim]
   Vectors moment;      // moment density [n_owned][R]
   Scalars energy;      // V_i (W_i + stabilization energy density) [n_owned]
+  Scalars pstar;       // p* of this evaluation (undrained split, below) [n_owned]
 
   void allocate(std::size_t n_all, std::size_t n_owned) {
     eps = Vectors("mupm::eps", n_all, Dim * Dim);
@@ -100,6 +101,7 @@ struct SolidState {
     force = Vectors("mupm::force", n_owned, Dim);
     moment = Vectors("mupm::moment", n_owned, R);
     energy = Scalars("mupm::strain_energy", n_owned);
+    pstar = Scalars("mupm::solid_pore_pressure", n_owned);
   }
   // What pass 2 reads from the neighbours, besides u and theta.
   std::vector<Vectors> pass2_ghosts() const { return {eps, kappa, P1, P2, as_vectors(w0)}; }
@@ -143,7 +145,7 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   auto eps_v = st.eps, kap_v = st.kappa, P1 = st.P1, P2 = st.P2, w0_v = st.w0;
   auto degen = st.degenerate;
   auto energy = st.energy;
-  auto pstar = pts.solid_pressure;
+  auto pstar = st.pstar;
   const MicropolarElastic law = prm.law;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;  // G C1 |xi|^3
   const double c2 = prm.stabilization * prm.stab_modulus;         // G C2 |xi|

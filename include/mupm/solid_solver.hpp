@@ -52,7 +52,6 @@ class SolidSolver {
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
-    pstar_old_ = Scalars("mupm::solid_pore_pressure_old", p.n_owned);
   }
 
   const SolidState<Dim>& state() const { return st_; }
@@ -91,17 +90,15 @@ class SolidSolver {
     if (!restarted)
       apply_kinematic(bcs_, p, t, 0.0);
     disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
-    // A restart keeps the p* of the last force evaluation before the checkpoint (the pore work
-    // of the next step starts from it), not the one of the pressure the fluid has updated since.
-    Scalars kept("mupm::solid_pressure_kept", restarted ? p.size() : 0);
-    if (restarted)
-      Kokkos::deep_copy(kept, p.solid_pressure);
     forces(t);
-    if (restarted)
-      Kokkos::deep_copy(p.solid_pressure, kept);
-    if (!restarted)
+    // Points::solid_pressure is the p* of the forces last applied (the pore work of the next
+    // step starts from it); a restart has it from the checkpoint, not from the pressure the
+    // fluid has updated since.
+    if (!restarted) {
+      keep_applied_pressure();
       advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                          0.0, 0.0);
+    }
   }
 
   // One step from t to t + dt.
@@ -116,12 +113,11 @@ class SolidSolver {
     double w[3] = {0.5 * power(), 0, 0};  // old forces on the increment (trapezoid, first half)
     Kokkos::deep_copy(vs_old_,
                       Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
-    Kokkos::deep_copy(pstar_old_,
-                      Kokkos::subview(p.solid_pressure, std::make_pair(std::size_t(0), p.n_owned)));
     forces(t + dt);
     w[0] += 0.5 * power();  // new forces (second half)
     w[1] = dt * damping_power();
     w[2] = pore_power();
+    keep_applied_pressure();
     MPI_Allreduce(MPI_IN_PLACE, w, 3, MPI_DOUBLE, MPI_SUM, comm_);
     work_ += w[0];
     dissipation_ += w[1];
@@ -192,7 +188,7 @@ class SolidSolver {
   // Largest stable step of the undamped central difference, 2 / omega_max, with omega_max^2
   // the largest eigenvalue of M^-1 K of the discrete operator (prescribed components held),
   // by power iteration with the mass-weighted Rayleigh quotient (it approaches omega_max^2
-  // from below). The state (and the p* of the last force evaluation) is restored afterwards.
+  // from below). The state is restored afterwards.
   // With a fluid the operator includes the undrained stiffness S_r^2 / C of the undrained split
   // (include/mupm/solid.hpp): the fastest waves are the undrained ones.
   double estimate_stable_dt(int iterations = 40) {
@@ -202,10 +198,9 @@ class SolidSolver {
     Vectors u0("u0", n, Dim), t0("t0", n, R);
     Kokkos::deep_copy(u0, p.u);
     Kokkos::deep_copy(t0, p.theta);
-    Scalars p0("p0", n), ref0("ref0", n), ps0("ps0", n);
+    Scalars p0("p0", n), ref0("ref0", n);
     Kokkos::deep_copy(p0, p.p);
     Kokkos::deep_copy(ref0, p.vol_strain_ref);
-    Kokkos::deep_copy(ps0, p.solid_pressure);
     Kokkos::deep_copy(p.p, 0.0);  // the operator's linear part only
     Kokkos::deep_copy(p.vol_strain_ref, 0.0);
     auto u = p.u, th = p.theta, gid = p.gid;
@@ -261,7 +256,6 @@ class SolidSolver {
     Kokkos::deep_copy(p.vol_strain_ref, ref0);
     disc_.dist.refresh({p.u, p.theta});
     solid_forces(p, disc_.bonds, prm_, st_, disc_.dist);
-    Kokkos::deep_copy(p.solid_pressure, ps0);
     return lambda > 0 ? 2.0 / std::sqrt(lambda) : 0.0;
   }
 
@@ -282,6 +276,12 @@ class SolidSolver {
         });
   }
 
+  void keep_applied_pressure() {
+    auto& p = disc_.points;
+    Kokkos::deep_copy(Kokkos::subview(p.solid_pressure, std::make_pair(std::size_t(0), p.n_owned)),
+                      st_.pstar);
+  }
+
   // sum_i V_i S_r (p*_old + p*_new)/2 (tr eps_new - tr eps_old) of this step (this rank's
   // points; step() sums over ranks), with the p* the forces were evaluated with: the old one
   // is from before any fluid update in between, as the first half of the velocity update
@@ -289,7 +289,7 @@ class SolidSolver {
   double pore_power() const {
     const auto& p = disc_.points;
     auto vs = p.vol_strain, sr = p.saturation, vol = p.volume;
-    auto ps = p.solid_pressure, ps_old = pstar_old_;
+    auto ps = st_.pstar, ps_old = p.solid_pressure;
     auto old = vs_old_;
     double w = 0;
     Kokkos::parallel_reduce(
@@ -379,7 +379,7 @@ class SolidSolver {
   SolidState<Dim> st_;
   Scalars rho_, inertia_;
   Vectors body_, couple_, du_;
-  Scalars vs_old_, pstar_old_;
+  Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0;
 };
 
