@@ -777,14 +777,13 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     ++step;
     time += dt;
     // Energy balances (eqs 140 and 149): warn, or stop, beyond the tolerance.
-    auto check_balance = [&](const char* what, double err, double scale, long long& warnings) {
+    auto check_balance = [&](const char* what, const char* balance, double err, double scale,
+                             long long& warnings) {
       if (step - first_step <= energy_skip || !(err > energy_tol * scale && scale > 0))
         return;
       std::ostringstream s;
       s << what << " energy balance violated at step " << step << " (t = " << time << " s): |"
-        << (what[0] == 's' ? "E_int + E_kin + D - W_ext - W_pore - E_0"
-                           : "E_s - E_s0 + W_c + D - W_ext")
-        << "| = " << err << " J is " << err / scale
+        << balance << "| = " << err << " J is " << err / scale
         << " of the largest term (Solver->Energy Tolerance = " << energy_tol << ")";
       if (energy_stop)
         throw CollectiveError("Error, " + s.str() + ".");
@@ -794,11 +793,13 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     };
     if (solid) {
       const auto e = solid_solver->energy();
-      check_balance("solid", std::abs(e.balance() - energy0), e.scale(), energy_warnings);
+      check_balance("solid", "E_int + E_kin + D - W_ext - W_pore - E_0",
+                    std::abs(e.balance() - energy0), e.scale(), energy_warnings);
     }
     if (fluid) {
       const auto e = fluid_solver->energy();
-      check_balance("fluid", std::abs(e.balance()), e.scale(), fluid_energy_warnings);
+      check_balance("fluid", "E_s - E_s0 + W_c + D - W_ext", std::abs(e.balance()), e.scale(),
+                    fluid_energy_warnings);
     }
     if (check_finite) {
       GlobalId bad = non_finite_point(pts);

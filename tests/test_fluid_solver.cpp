@@ -314,7 +314,6 @@ struct ColumnRun {
   ColumnRun(const Terzaghi& tz, int rows_h, bool fluid_first, double dt_factor, bool damped = true)
       : disc(discretize(test::world(), column_grid(tz, rows_h))) {
     const auto& g = disc.grid;
-    const double W = g.counts[0] * tz.dx, top = g.counts[1] * tz.dx;
     Kokkos::deep_copy(disc.points.porosity, tz.phi);
     Kokkos::deep_copy(disc.points.saturation, 1.0);
     std::vector<BoundaryCondition> bcs;
@@ -337,8 +336,6 @@ struct ColumnRun {
     bcs.back().time.ramp_time = tz.t_r;
     add("drain_base", BoundaryCondition::PorePressure, 2, 0, 0.0);
     add("drain_top", BoundaryCondition::PorePressure, 3, 0, 0.0);
-    (void)W;
-    (void)top;
     SolidParams sp;
     sp.law = tz.law;
     sp.stabilization = 0.5;

@@ -252,11 +252,12 @@ class FluidSolver {
   }
 
  private:
-  // S_r, k_r, C and the flow of the current pressure (ghosts refreshed).
+  // S_r, k_r, C and the flow of the current pressure. Only p is read on the ghosts (k_r of a
+  // neighbour reaches pass 2 inside its alpha).
   void evaluate() {
     auto& p = disc_.points;
     fluid_constitutive(p, prm_, st_);
-    disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation), as_vectors(p.rel_perm)});
+    disc_.dist.refresh({as_vectors(p.p)});
     fluid_flow(p, disc_.bonds, prm_, st_, disc_.dist, p.p);
   }
 
