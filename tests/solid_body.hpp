@@ -64,23 +64,7 @@ struct Body {
     MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
     return e;
   }
-  // Owned points at least `rows` spacings inside: rows >= 2 delta/dx puts the families of the
-  // point and of all its neighbours inside the body.
-  std::vector<bool> interior(int rows) {
-    auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts().x);
-    const auto& g = disc.grid;
-    std::vector<bool> in(pts().n_owned);
-    for (std::size_t i = 0; i < pts().n_owned; ++i) {
-      bool ok = true;
-      for (int d = 0; d < Dim; ++d) {
-        const double lo = g.origin[d] - g.layers[d][0] * g.dx;
-        const double hi = g.origin[d] + (g.counts[d] + g.layers[d][1]) * g.dx;
-        ok = ok && x(i, d) > lo + rows * g.dx && x(i, d) < hi - rows * g.dx;
-      }
-      in[i] = ok;
-    }
-    return in;
-  }
+  std::vector<bool> interior(int rows) { return interior_points(disc, rows); }
 };
 
 }  // namespace mupm::test

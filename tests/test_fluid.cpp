@@ -77,24 +77,9 @@ struct FluidBody {
     Kokkos::deep_copy(pts().p, p);
   }
   void flow() {
-    fluid_constitutive(pts(), prm, st);
-    disc.dist.refresh({as_vectors(pts().rel_perm)});
+    fluid_constitutive(pts(), prm, st);  // p is set on owned and ghost points alike
     fluid_flow(pts(), disc.bonds, prm, st, disc.dist, pts().p);
     Kokkos::fence();
-  }
-  // Owned points whose family and neighbours' families are full (rows spacings inside).
-  std::vector<bool> interior(double rows) {
-    auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts().x);
-    const auto& g = disc.grid;
-    std::vector<bool> in(pts().n_owned);
-    for (std::size_t i = 0; i < pts().n_owned; ++i) {
-      bool ok = true;
-      for (int d = 0; d < Dim; ++d)
-        ok = ok && x(i, d) > g.origin[d] + rows * g.dx &&
-             x(i, d) < g.origin[d] + g.counts[d] * g.dx - rows * g.dx;
-      in[i] = ok;
-    }
-    return in;
   }
 };
 
@@ -128,7 +113,7 @@ TYPED_TEST(FluidKernels, LinearPressureGradientIsExact) {
   auto grad = Kokkos::create_mirror_view_and_copy(HostSpace(), body.st.grad);
   auto q = Kokkos::create_mirror_view_and_copy(HostSpace(), body.pts().darcy_flux);
   auto flow = Kokkos::create_mirror_view_and_copy(HostSpace(), body.st.flow);
-  const auto in = body.interior(6.1);
+  const auto in = test::interior_points(body.disc, 6);
   int n_in = 0;
   for (std::size_t i = 0; i < body.pts().n_owned; ++i) {
     for (int d = 0; d < Dim; ++d) {
@@ -165,7 +150,7 @@ TYPED_TEST(FluidKernels, LinearFluxDivergenceIsExact) {
       trH += H[d][d];
     const double expected = -body.prm.mobility * trH;
     auto flow = Kokkos::create_mirror_view_and_copy(HostSpace(), body.st.flow);
-    const auto in = body.interior(6.1);
+    const auto in = test::interior_points(body.disc, 6);
     int n_in = 0;
     for (std::size_t i = 0; i < body.pts().n_owned; ++i)
       if (in[i]) {
@@ -224,7 +209,7 @@ TYPED_TEST(FluidKernels, CheckerboardIsDampedByStabilization) {
     auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), body.disc.bonds.offsets);
     auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), body.disc.bonds.neighbor);
     auto vol = Kokkos::create_mirror_view_and_copy(HostSpace(), body.pts().volume);
-    const auto in = body.interior(6.1);
+    const auto in = test::interior_points(body.disc, 6);
     int n_in = 0;
     for (std::size_t i = 0; i < body.pts().n_owned; ++i) {
       if (!in[i])

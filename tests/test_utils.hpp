@@ -6,6 +6,7 @@
 #include <Tpetra_Core.hpp>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "mupm/discretization.hpp"
 
@@ -39,6 +40,25 @@ std::array<double, Dim> position(const GridSpec<Dim>& g, GlobalId gid) {
     x[d] = g.origin[d] + (double(k) + 0.5) * g.dx;
   }
   return x;
+}
+
+// Owned points at least `rows` spacings inside the lattice (boundary layers included): rows >=
+// 2 delta/dx puts the families of the point and of all its neighbours inside the body.
+template <int Dim>
+std::vector<bool> interior_points(const Discretization<Dim>& disc, int rows) {
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.x);
+  const auto& g = disc.grid;
+  std::vector<bool> in(disc.points.n_owned);
+  for (std::size_t i = 0; i < disc.points.n_owned; ++i) {
+    bool ok = true;
+    for (int d = 0; d < Dim; ++d) {
+      const double lo = g.origin[d] - g.layers[d][0] * g.dx;
+      const double hi = g.origin[d] + (g.counts[d] + g.layers[d][1]) * g.dx;
+      ok = ok && x(i, d) > lo + rows * g.dx && x(i, d) < hi - rows * g.dx;
+    }
+    in[i] = ok;
+  }
+  return in;
 }
 
 inline std::string tmp_dir() {
