@@ -360,6 +360,15 @@ Handle memory_space(hsize_t n) {
   return s;
 }
 
+// Opens an existing dataset, or throws "not found" / "cannot open" with the context.
+Handle open_dataset(hid_t file, const std::string& cname, const std::string& ctx) {
+  if (!dataset_exists(file, cname)) {
+    throw std::runtime_error(ctx + ": dataset not found");
+  }
+  return Handle(check_id(H5Dopen2(file, cname.c_str(), H5P_DEFAULT), ctx + ": cannot open"),
+                H5Dclose);
+}
+
 Handle collective_xfer() {
   Handle dxpl = make_plist(H5P_DATASET_XFER, "cannot create transfer property list");
   check_err(H5Pset_dxpl_mpio(dxpl.get(), H5FD_MPIO_COLLECTIVE), "cannot request collective I/O");
@@ -503,11 +512,7 @@ void read_points_impl(MPI_Comm comm, hid_t file, const std::string& path, const 
       throw std::runtime_error(ctx + ": null output for " + std::to_string(gids.size()) +
                                " points");
     }
-    if (!dataset_exists(file, cname)) {
-      throw std::runtime_error(ctx + ": dataset not found");
-    }
-    dset = Handle(check_id(H5Dopen2(file, cname.c_str(), H5P_DEFAULT), ctx + ": cannot open"),
-                  H5Dclose);
+    dset = open_dataset(file, cname, ctx);
     Handle fspace(check_id(H5Dget_space(dset.get()), ctx + ": cannot get dataspace"), H5Sclose);
     Handle ftype(check_id(H5Dget_type(dset.get()), ctx + ": cannot get type"), H5Tclose);
     const std::vector<hsize_t> dims = space_dims(fspace.get());
@@ -922,11 +927,7 @@ std::vector<double> PointFile::read_global(const std::string& name) const {
   std::vector<double> values;
   Handle dset, dxpl;
   collective(comm_, [&] {
-    if (!dataset_exists(file_, cname)) {
-      throw std::runtime_error(ctx + ": dataset not found");
-    }
-    dset = Handle(check_id(H5Dopen2(file_, cname.c_str(), H5P_DEFAULT), ctx + ": cannot open"),
-                  H5Dclose);
+    dset = open_dataset(file_, cname, ctx);
     Handle space(check_id(H5Dget_space(dset.get()), ctx + ": cannot get dataspace"), H5Sclose);
     Handle ftype(check_id(H5Dget_type(dset.get()), ctx + ": cannot get type"), H5Tclose);
     const std::vector<hsize_t> dims = space_dims(space.get());
