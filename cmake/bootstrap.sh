@@ -4,6 +4,8 @@
 #   bash cmake/bootstrap.sh quickstart   run inputs/quickstart.xml on 2 ranks (build/quickstart)
 #   bash cmake/bootstrap.sh test         run the test suite (ctest)
 #   bash cmake/bootstrap.sh build        only build
+#   bash cmake/bootstrap.sh sanitize     build with ASan + UBSan in ./build-sanitize instead and run
+#                                        the test suite there (ctest)
 set -euo pipefail
 what=${1:-build}
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -12,6 +14,20 @@ cd "$root"
 prefix_line=$(bash cmake/setup.sh | tail -n 1)
 prefix=${prefix_line#MUPM_TRILINOS_PREFIX=}
 jobs=$(nproc)
+
+if [[ $what == sanitize ]]; then
+  # mupm (not Trilinos) instrumented with AddressSanitizer + UndefinedBehaviorSanitizer. The options
+  # reach the MPI ranks: Open MPI passes mpirun's environment to the ranks it starts locally.
+  cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMUPM_SANITIZE=ON \
+    -DMUPM_ENABLE_BENCHMARKS=OFF -DCMAKE_PREFIX_PATH="$prefix" >build-configure.log 2>&1 ||
+    { cat build-configure.log; exit 1; }
+  rm -f build-configure.log
+  cmake --build build-sanitize -j"$jobs"
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  export LSAN_OPTIONS=suppressions=$root/cmake/lsan.supp:print_suppressions=0
+  ctest --test-dir build-sanitize --output-on-failure -j"$jobs"
+  exit
+fi
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" >build-configure.log 2>&1 ||
   { cat build-configure.log; exit 1; }
@@ -34,7 +50,7 @@ case "$what" in
     ;;
   build) ;;
   *)
-    echo "usage: bash cmake/bootstrap.sh [build|quickstart|test]" >&2
+    echo "usage: bash cmake/bootstrap.sh [build|quickstart|test|sanitize]" >&2
     exit 1
     ;;
 esac

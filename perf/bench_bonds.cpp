@@ -3,8 +3,8 @@
 // (the shape tensor of pass 1, eq 45), in 2D and 3D at delta = 3.015 dx and 4.015 dx.
 // Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads ./perf/bench_bonds
 #include "bench_common.hpp"
-#include "mupm/discretization.hpp"
-#include "mupm/shape_tensor.hpp"
+#include "mupm/kernels/shape_tensor.hpp"
+#include "mupm/mesh/discretization.hpp"
 
 namespace {
 

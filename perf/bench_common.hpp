@@ -11,7 +11,7 @@
 #include <memory>
 #include <tuple>
 
-#include "mupm/grid.hpp"
+#include "mupm/mesh/grid.hpp"
 
 namespace mupm::bench {
 

@@ -8,19 +8,18 @@
 #include <memory>
 
 #include "bench_common.hpp"
-#include "mupm/staggered.hpp"
+#include "mupm/input/model.hpp"
+#include "mupm/solvers/solid_solver.hpp"
+#include "mupm/solvers/step_sequence.hpp"
 
 namespace {
 
 using namespace mupm;
 
 template <int Dim>
-FluidParams fluid_params(const GridSpec<Dim>& g) {
-  FluidParams f;
-  f.mobility = 1e-10;
+FluidParams bench_fluid_params(const GridSpec<Dim>& g) {
+  FluidParams f = fluid_params(g, 1e-10);
   f.retention = VanGenuchten::mualem(10e3, 2.0);  // unsaturated: every retention branch runs
-  f.horizon_volume = g.family_volume();
-  f.second_moment = family_second_moment<Dim>(g.horizon, g.thickness);
   return f;
 }
 
@@ -48,12 +47,12 @@ struct FlowBody {
   FluidState<Dim> st;
 
   explicit FlowBody(const GridSpec<Dim>& g) : disc(discretize(bench::self(), g)) {
-    prm = fluid_params(g);
+    prm = bench_fluid_params(g);
     st.allocate(disc.points.size(), disc.points.n_owned);
     Kokkos::deep_copy(disc.points.porosity, 0.3);
     set_pressure(disc.points, g.dx);
     fluid_constitutive(disc.points, prm, st);
-    fluid_flow(disc.points, disc.bonds, prm, st, disc.dist, disc.points.p);
+    fluid_flow(disc, prm, st, disc.points.p);
     Kokkos::fence();
   }
 };
@@ -65,19 +64,16 @@ struct CoupledBody {
   Discretization<Dim> disc;
   std::unique_ptr<FluidSolver<Dim>> fluid;
   std::unique_ptr<SolidSolver<Dim>> solid;
-  Staggered<Dim> stagger;
+  StepSequence<Dim> stagger;
   double dt = 0;
   long long step = 0;
 
   explicit CoupledBody(const GridSpec<Dim>& g) : disc(discretize(bench::self(), g)) {
     Kokkos::deep_copy(disc.points.porosity, 0.3);
     set_pressure(disc.points, g.dx);
-    SolidParams sp;
-    sp.law = MicropolarElastic::from_bulk_shear(270.83e6, 220.33e6, 100e6, 7.5e-3);
-    sp.stab_modulus =
-        stabilization_modulus<Dim>(sp.law, g.horizon, g.thickness, StabilizationModulus::Automatic);
-    sp.horizon_volume = fluid_params(g).horizon_volume;
-    fluid = std::make_unique<FluidSolver<Dim>>(disc, fluid_params(g),
+    const SolidParams sp =
+        solid_params(MicropolarElastic::from_bulk_shear(270.83e6, 220.33e6, 100e6, 7.5e-3), g, 0.5);
+    fluid = std::make_unique<FluidSolver<Dim>>(disc, bench_fluid_params(g),
                                                std::vector<BoundaryCondition>{}, MPI_COMM_SELF);
     solid =
         std::make_unique<SolidSolver<Dim>>(disc, sp, std::vector<BoundaryCondition>{},
@@ -87,7 +83,7 @@ struct CoupledBody {
     fluid->reset_strain_reference();
     // A step well inside both limits; the benchmark times work per step, not stability.
     dt = 1e-3 * solid->estimate_stable_dt(20);
-    stagger = {solid.get(), fluid.get(), false, 1, 1};
+    stagger = {solid.get(), fluid.get(), nullptr, false, 1, 1};
   }
 };
 
@@ -100,7 +96,7 @@ template <int Dim>
 void BM_FluidPass1(benchmark::State& state) {
   auto& b = bench::body<FlowBody<Dim>>(state);
   for (auto _ : state) {
-    fluid_pass1(b.disc.points, b.disc.bonds, b.prm, b.st, b.disc.points.p);
+    fluid_pass1(b.disc.points, b.disc.bonds, b.disc.shape, b.prm, b.st, b.disc.points.p);
     Kokkos::fence();
   }
   counters(state, b);
@@ -120,7 +116,7 @@ template <int Dim>
 void BM_FluidFlow(benchmark::State& state) {
   auto& b = bench::body<FlowBody<Dim>>(state);
   for (auto _ : state) {
-    fluid_flow(b.disc.points, b.disc.bonds, b.prm, b.st, b.disc.dist, b.disc.points.p);
+    fluid_flow(b.disc, b.prm, b.st, b.disc.points.p);
     Kokkos::fence();
   }
   counters(state, b);

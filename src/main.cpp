@@ -5,8 +5,8 @@
 #include <cstring>
 #include <iostream>
 
-#include "mupm/input.hpp"
-#include "mupm/simulation.hpp"
+#include "mupm/input/input.hpp"
+#include "mupm/solvers/simulation.hpp"
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "mupm/discretization.hpp"
+#include "mupm/mesh/discretization.hpp"
 
 namespace mupm::test {
 

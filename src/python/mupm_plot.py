@@ -10,13 +10,23 @@ import argparse
 import csv
 import glob
 import os
+import shlex
+import sys
 
-import h5py
-import matplotlib
+try:
+    import h5py
+    import matplotlib
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+except ImportError as e:
+    sys.exit(
+        "mupm_plot.py needs h5py and matplotlib (with numpy); this Python (%s) cannot import "
+        "%s.\nInstall them: apt-get install python3-h5py python3-matplotlib (Debian's "
+        "/usr/bin/python3), or pip install h5py matplotlib (this Python).\nOr run it with "
+        "Debian's Python: /usr/bin/python3 %s"
+        % (sys.executable, e.name or e, " ".join(map(shlex.quote, sys.argv))))
 
 
 def plot_field(args):

@@ -1,0 +1,41 @@
+// What the field registries (Points::for_each_field, Bonds::for_each_field) say of a field.
+#ifndef MUPM_FIELDS_HPP
+#define MUPM_FIELDS_HPP
+
+#include <cstddef>
+#include <string>
+
+#include "mupm/core/types.hpp"
+
+namespace mupm {
+
+enum FieldTrait : unsigned {
+  kConstant = 1u << 0,    // per-point constant: sent to the ghosts once, at discretization
+  kGhosted = 1u << 1,     // state refreshed on the ghosts at a start and after a restart
+  kCheckpoint = 1u << 2,  // kept by the checkpoint (points by global id, bonds by their ends)
+  kOutput = 1u << 3,      // selectable in Output->Fields
+  kFinite = 1u << 4,      // checked for NaN and Inf after every step (Diagnostics->Check Finite)
+};
+
+struct FieldSpec {
+  const char* name;  // output and checkpoint dataset name (snake_case)
+  int ncomp;         // components per point (per bond for bond fields)
+  unsigned traits;
+  // Name under which Initial Conditions->NAME->Field sets it, or nullptr.
+  const char* initial_condition = nullptr;
+  bool has(unsigned t) const { return (traits & t) == t; }
+};
+
+// Allocates a registry field with n rows (n x ncomp for a rank-2 View; ncomp = 1 for rank 1).
+template <class View>
+void allocate_field(View& v, const FieldSpec& s, std::size_t n) {
+  const std::string label = std::string("mupm::") + s.name;
+  if constexpr (View::rank == 1)
+    v = View(label, n);
+  else
+    v = View(label, n, std::size_t(s.ncomp));
+}
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,179 @@
+// Point data of the whole model as a struct of Kokkos Views, owned points first, then ghosts
+// (ExaMiniMD `system.h`, CabanaPD `Particles`), and the registry of those fields.
+//
+// The registry (Points::for_each_field) declares every per-point field once: its name, its
+// component count and its traits (include/mupm/data/fields.hpp). Allocation, the bytes per
+// point, the ghost exchanges, the checkpoint, the output list and its validator, the
+// initial-condition names, the NaN check and the README's field list (checked by a test) all
+// follow from it. A new field is one member below and one line in for_each_field.
+#ifndef MUPM_POINTS_HPP
+#define MUPM_POINTS_HPP
+
+#include <cstddef>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "mupm/core/types.hpp"
+#include "mupm/data/fields.hpp"
+
+namespace mupm {
+
+// Bits of Points::flags. Region membership is kept apart in Points::regions (one bit a region).
+enum PointFlag : std::uint32_t {
+  kFlagBoundaryLayer = 1u << 0,  // a boundary-layer (fictitious) point outside the real body
+  kFlagPreCrack = 1u << 1,       // adjacent to an initial crack
+  // Face of the boundary layer the point belongs to: bit kFlagLayerFace0 << (2*axis + side).
+  kFlagLayerFace0 = 1u << 2,
+};
+
+// Bit of Points::fixed marking a prescribed pore pressure (bits 0..Dim+RotDim-1: u and theta).
+inline constexpr std::uint32_t kFixedPressure = 1u << 31;
+
+inline constexpr std::uint32_t layer_face_flag(int axis, int side) {
+  return kFlagLayerFace0 << (2 * axis + side);
+}
+
+template <int Dim>
+struct Points {
+  static constexpr int dim = Dim;
+  static constexpr int rot_dim = kRotDim<Dim>;
+
+  std::size_t n_owned = 0;
+  std::size_t n_ghost = 0;
+  std::size_t size() const { return n_owned + n_ghost; }
+
+  // Constant per point: exchanged once.
+  GlobalIds gid;   // global id
+  Vectors x;       // reference position [n][Dim]
+  Scalars volume;  // V_i (2D: area times thickness)
+  Flags flags;     // PointFlag bits
+  Flags regions;   // bit r: the point lies in named region r
+  Flags fixed;     // bit d: u_d prescribed; bit Dim + r: theta_r prescribed; kFixedPressure: p
+  // Kinematics of the solid (central difference, eqs 127-136).
+  Vectors u, v, a;              // displacement, velocity, acceleration [n][Dim]
+  Vectors theta, omega, alpha;  // micro-rotation and its rates [n][RotDim]
+  // Fluid (eqs 141-146) and fracture fluid (eqs 119-120).
+  Scalars p, p_rate;    // pore water pressure and its rate
+  Scalars pf, pf_rate;  // fracture pressure and its rate
+  Scalars porosity, saturation;
+  Scalars rel_perm;           // relative permeability k_r (eq 56)
+  Vectors darcy_flux;         // q [m/s] (eq 54) [n][Dim]
+  Scalars vol_strain;         // tr(eps) of the solid (eq 117)
+  Scalars vol_strain_ref;     // tr(eps) at the last fluid update
+  Scalars fluid_content;      // water volume per unit volume, phi S_r (1 + p/K_w) at t = 0 plus
+                              // the increments C dp + S_r d(tr eps) of every fluid step
+  Scalars solid_pressure;     // p* of the forces the solid last applied (undrained split)
+  Scalars undrained_modulus;  // S_r / C [Pa]: dp = -(S_r/C) d(tr eps) at fixed water content;
+                              // 0 where p is prescribed or without a fluid (undrained split)
+  // Fracture.
+  Scalars damage;  // D_i (eq 37)
+  Bytes fracture;  // 1: fracture point (D >= D_cr or next to a pre-crack)
+  // Constitutive state: effective stress, couple stress, equivalent plastic strain.
+  Vectors stress;                 // sigma-bar [n][Dim*Dim], row-major, non-symmetric
+  Vectors couple_stress;          // m [n][RotDim*Dim]
+  Scalars plastic_strain;         // equivalent plastic strain (eq 95)
+  Vectors plastic_strain_tensor;  // eps^p [n][Dim*Dim], row-major (the additive split, eq 82)
+
+  // The registry: f(view, spec) for every field, in this order (the checkpoint's and the
+  // output list's). Traits: kConstant (sent to the ghosts once), kGhosted (refreshed on the
+  // ghosts at a start and a restart), kCheckpoint, kOutput (selectable in Output->Fields),
+  // kFinite (checked for NaN/Inf every step); the last argument is the name under which an
+  // initial condition sets the field (Initial Conditions->NAME->Field), or nullptr.
+  template <class F>
+  void for_each_field(F&& f) {
+    visit(*this, f);
+  }
+  template <class F>
+  void for_each_field(F&& f) const {
+    visit(*this, f);
+  }
+
+  Points() = default;
+  Points(std::size_t owned, std::size_t ghost) { allocate(owned, ghost); }
+
+  void allocate(std::size_t owned, std::size_t ghost) {
+    n_owned = owned;
+    n_ghost = ghost;
+    const std::size_t n = owned + ghost;
+    for_each_field([n](auto& view, const FieldSpec& s) { allocate_field(view, s, n); });
+  }
+
+  // Resident bytes of one point (all fields of the registry).
+  static std::size_t bytes_per_point() {
+    std::size_t b = 0;
+    Points().for_each_field([&b](const auto& view, const FieldSpec& s) {
+      b += sizeof(typename std::decay_t<decltype(view)>::value_type) * std::size_t(s.ncomp);
+    });
+    return b;
+  }
+
+  // The double fields with every trait of t, each as [n][ncomp] (e.g. the kGhosted ones for a
+  // ghost refresh).
+  std::vector<Vectors> double_fields(unsigned t) const {
+    std::vector<Vectors> out;
+    for_each_field([&](const auto& view, const FieldSpec& s) {
+      using V = std::decay_t<decltype(view)>;
+      if constexpr (std::is_same_v<typename V::value_type, double>) {
+        if (!s.has(t))
+          return;
+        if constexpr (V::rank == 1)
+          out.push_back(as_vectors(view));
+        else
+          out.push_back(view);
+      }
+    });
+    return out;
+  }
+
+  // The specs alone (names, components, traits), e.g. for the input's validators.
+  static std::vector<FieldSpec> specs() {
+    std::vector<FieldSpec> out;
+    Points().for_each_field([&out](const auto&, const FieldSpec& s) { out.push_back(s); });
+    return out;
+  }
+
+ private:
+  template <class P, class F>
+  static void visit(P& p, F& f) {
+    constexpr int D = Dim, R = rot_dim;
+    constexpr unsigned kState = kCheckpoint | kOutput;
+    // clang-format off
+    f(p.gid,               FieldSpec{"global_id", 1, 0});
+    f(p.x,                 FieldSpec{"coordinates", D, kConstant});
+    f(p.volume,            FieldSpec{"volume", 1, kConstant});
+    f(p.flags,             FieldSpec{"flags", 1, kConstant | kOutput});
+    f(p.regions,           FieldSpec{"regions", 1, kConstant | kOutput});
+    f(p.fixed,             FieldSpec{"fixed", 1, 0});
+    f(p.u,                 FieldSpec{"displacement", D, kState | kGhosted | kFinite, "Displacement"});
+    f(p.v,                 FieldSpec{"velocity", D, kState | kGhosted | kFinite, "Velocity"});
+    f(p.a,                 FieldSpec{"acceleration", D, kState | kFinite});
+    f(p.theta,             FieldSpec{"micro_rotation", R, kState | kGhosted | kFinite, "Micro-Rotation"});
+    f(p.omega,             FieldSpec{"micro_rotation_rate", R, kState | kFinite, "Micro-Rotation Rate"});
+    f(p.alpha,             FieldSpec{"micro_rotation_acceleration", R, kCheckpoint | kFinite});
+    f(p.p,                 FieldSpec{"pore_pressure", 1, kState | kGhosted | kFinite, "Pore Pressure"});
+    f(p.p_rate,            FieldSpec{"pore_pressure_rate", 1, kCheckpoint});
+    f(p.pf,                FieldSpec{"fracture_pressure", 1, kState | kGhosted | kFinite, "Fracture Pressure"});
+    f(p.pf_rate,           FieldSpec{"fracture_pressure_rate", 1, kCheckpoint});
+    f(p.porosity,          FieldSpec{"porosity", 1, kState, "Porosity"});
+    f(p.saturation,        FieldSpec{"saturation", 1, kState, "Saturation"});
+    f(p.rel_perm,          FieldSpec{"relative_permeability", 1, kState});
+    f(p.darcy_flux,        FieldSpec{"darcy_flux", D, kState});
+    f(p.vol_strain,        FieldSpec{"volumetric_strain", 1, kState});
+    f(p.vol_strain_ref,    FieldSpec{"volumetric_strain_reference", 1, kCheckpoint});
+    f(p.fluid_content,     FieldSpec{"fluid_content", 1, kState});
+    f(p.solid_pressure,    FieldSpec{"solid_pressure", 1, kCheckpoint});
+    f(p.undrained_modulus, FieldSpec{"undrained_modulus", 1, 0});
+    f(p.damage,            FieldSpec{"damage", 1, kState | kGhosted});
+    f(p.fracture,          FieldSpec{"fracture", 1, kConstant | kState});
+    f(p.stress,            FieldSpec{"stress", D * D, kState});
+    f(p.couple_stress,     FieldSpec{"couple_stress", R * D, kState});
+    f(p.plastic_strain,    FieldSpec{"plastic_strain", 1, kState});
+    f(p.plastic_strain_tensor, FieldSpec{"plastic_strain_tensor", D * D, kState});
+    // clang-format on
+  }
+};
+
+}  // namespace mupm
+
+#endif

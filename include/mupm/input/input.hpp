@@ -1,0 +1,63 @@
+// Input layer: the Teuchos XML parameter list, read on rank 0 and broadcast, validated against
+// the valid parameter lists below (defaults, doc strings, validators), and turned into the plain
+// structs the lower layers take (no Teuchos below this layer).
+#ifndef MUPM_INPUT_HPP
+#define MUPM_INPUT_HPP
+
+#include <Teuchos_Comm.hpp>
+#include <Teuchos_ParameterList.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mupm/core/error.hpp"
+#include "mupm/kernels/boundary_conditions.hpp"
+#include "mupm/mesh/grid.hpp"
+
+namespace mupm {
+
+// An error in the input. Its message names the parameter's full path and what was expected.
+// Thrown on every rank alike (the list is identical on every rank after the broadcast).
+struct InputError : CollectiveError {
+  using CollectiveError::CollectiveError;
+};
+
+// Every parameter with its default, doc string and validator. User-named sublists (regions,
+// pre-cracks, initial conditions) are shown by one example entry named "NAME".
+Teuchos::RCP<Teuchos::ParameterList> valid_parameters();
+
+// Reads the XML file on rank 0 and broadcasts it; every rank parses the same text. A missing
+// file or malformed XML throws InputError on every rank.
+Teuchos::RCP<Teuchos::ParameterList> read_input(const Teuchos::Comm<int>& comm,
+                                                const std::string& path);
+Teuchos::RCP<Teuchos::ParameterList> parse_input(const std::string& xml);
+
+// Validates the list in place and fills in every default. Throws InputError.
+void validate_input(Teuchos::ParameterList& input);
+
+int input_dimension(const Teuchos::ParameterList& input);
+
+template <int Dim>
+GridSpec<Dim> grid_from_input(const Teuchos::ParameterList& input);
+
+// Initial Conditions->NAME->Field value that sets the hydrostatic pore pressure (not a field).
+inline constexpr const char* kHydrostaticPorePressure = "Hydrostatic Pore Pressure";
+
+// One initial condition: set `field` (the initial-condition name of a registry field,
+// include/mupm/data/points.hpp, or kHydrostaticPorePressure) to `value` on the points of
+// `region_mask` (0: all points).
+struct InitialCondition {
+  std::string name, field;
+  std::uint32_t region_mask = 0;
+  std::vector<double> value;
+};
+std::vector<InitialCondition> initial_conditions_from_input(const Teuchos::ParameterList& input);
+
+std::vector<BoundaryCondition> boundary_conditions_from_input(const Teuchos::ParameterList& input);
+
+// Names of the point fields that can be written (Output->Fields).
+const std::vector<std::string>& output_field_names();
+
+}  // namespace mupm
+
+#endif

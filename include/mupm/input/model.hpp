@@ -1,0 +1,89 @@
+// The model an input describes, as the plain structs the lower layers take, built in one place
+// (model_from_input) from the validated parameter list. The parameter builders below derive the
+// constants that depend on the grid (stabilization modulus, family volume and second moment);
+// tests and benchmarks call them too, so every caller gets the same constants.
+#ifndef MUPM_MODEL_HPP
+#define MUPM_MODEL_HPP
+
+#include <Teuchos_ParameterList.hpp>
+#include <string>
+#include <vector>
+
+#include "mupm/input/input.hpp"
+#include "mupm/input/options.hpp"
+#include "mupm/kernels/fluid.hpp"
+#include "mupm/kernels/solid.hpp"
+#include "mupm/mesh/grid.hpp"
+
+namespace mupm {
+
+// SolidParams of a law on a grid: G, D (eqs 69-71 by `choice`) and V_H.
+template <int Dim>
+SolidParams solid_params(const MicropolarElastic& law, const GridSpec<Dim>& g,
+                         double stabilization = 0.5,
+                         StabilizationModulus choice = StabilizationModulus::Automatic) {
+  SolidParams prm;
+  prm.law = law;
+  prm.stabilization = stabilization;
+  prm.stab_modulus = stabilization_modulus<Dim>(law, g.horizon, g.thickness, choice);
+  prm.horizon_volume = g.family_volume();
+  return prm;
+}
+
+// FluidParams with mobility k/mu_w and flow stabilization G on a grid: V_H and k2 from the grid,
+// everything else at its default (set the members afterwards).
+template <int Dim>
+FluidParams fluid_params(const GridSpec<Dim>& g, double mobility, double stabilization = 0.5) {
+  FluidParams f;
+  f.mobility = mobility;
+  f.stabilization = stabilization;
+  f.horizon_volume = g.family_volume();
+  f.second_moment = family_second_moment<Dim>(g.horizon, g.thickness);
+  return f;
+}
+
+// Settings of the run (Solver, Output, Diagnostics).
+struct RunSettings {
+  Physics physics = Physics::MicropolarSolid;
+  Staggering staggering = Staggering::SolidFirst;
+  int solid_steps_per_fluid_step = 1;
+  int fluid_substeps = 1;  // 0: automatic
+  double time_step = 1e-6;
+  bool automatic_time_step = false;
+  double safety = 0.5;
+  long long n_steps = 0;
+  double energy_tolerance = 1e-2;
+  bool stop_on_energy_violation = false;
+  long long energy_check_start = 20;
+  std::string restart_from;
+  // Output.
+  std::string folder = "output";
+  std::vector<std::string> fields;
+  int field_interval = 10, series_interval = 1, checkpoint_interval = 0;
+  bool checkpoint_at_end = true;
+  double progress_interval = 5;
+  // Diagnostics.
+  bool kernel_timers = true, check_finite = true;
+};
+
+template <int Dim>
+struct Model {
+  GridSpec<Dim> grid;
+  RunSettings run;
+  ConstitutiveModel constitutive_model = ConstitutiveModel::MicropolarElastic;
+  SolidParams solid;
+  double solid_density = 2000;  // rho_s
+  double damping = 0;           // Solver->Damping
+  FluidParams fluid;
+  double porosity = 0;                 // Materials->Porosity (initial)
+  Kokkos::Array<double, 3> gravity{};  // Solver->Gravity
+  std::vector<BoundaryCondition> boundary_conditions;
+  std::vector<InitialCondition> initial_conditions;
+};
+
+template <int Dim>
+Model<Dim> model_from_input(const Teuchos::ParameterList& input);
+
+}  // namespace mupm
+
+#endif

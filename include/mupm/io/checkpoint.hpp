@@ -1,0 +1,39 @@
+// Checkpoint and restart: the registries' checkpointed point fields keyed by global id, the
+// checkpointed bond fields keyed by the global ids of both ends, and the modules' restart
+// globals by name (globals/<module>/<name>). Independent of the number of ranks and threads.
+#ifndef MUPM_CHECKPOINT_HPP
+#define MUPM_CHECKPOINT_HPP
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mupm/mesh/discretization.hpp"
+
+namespace mupm {
+
+// The layout this mupm writes and reads (attribute mupm_checkpoint_version). 2: restart globals
+// by name.
+inline constexpr long long kCheckpointVersion = 2;
+
+// Named scalars, each pointing at its owner's value (written from it, read into it).
+using NamedGlobals = std::vector<std::pair<std::string, double*>>;
+
+// Collective checkpoint of points and bonds keyed by global id. The file is written beside
+// `path` and renamed over it once complete.
+template <int Dim>
+void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, long long step,
+                      double time, const std::vector<double>& output_history,
+                      const NamedGlobals& globals = {});
+// Collective restore of the step, the time, the output history, the point and bond fields and
+// the named globals; then the shape tensors of the restored bonds. Throws CollectiveError (on
+// every rank) when the checkpoint's version or discretization does not match, or a global is
+// missing.
+template <int Dim>
+void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long long& step,
+                     double& time, std::vector<double>& output_history,
+                     const NamedGlobals& globals = {});
+
+}  // namespace mupm
+
+#endif

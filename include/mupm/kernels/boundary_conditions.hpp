@@ -1,0 +1,179 @@
+// Boundary conditions by the boundary-layer method (paper section 3): prescribed displacement,
+// velocity and micro-rotation components on regions (usually the boundary layers), and
+// tractions and body forces as body-force densities; prescribed pore pressure and fluid sources
+// (applied by include/mupm/solvers/fluid_solver.hpp). Value types and kernels only.
+#ifndef MUPM_BOUNDARY_CONDITIONS_HPP
+#define MUPM_BOUNDARY_CONDITIONS_HPP
+
+#include <string>
+#include <vector>
+
+#include "mupm/data/points.hpp"
+
+namespace mupm {
+
+// g(t) of a condition: value * g(t).
+struct TimeFunction {
+  enum Kind { Constant, Ramp, Rate, Table } kind = Constant;
+  double ramp_time = 0;
+  std::vector<double> times, values;
+
+  double operator()(double t) const {
+    switch (kind) {
+      case Constant:
+        return 1.0;
+      case Ramp:
+        return ramp_time > 0 ? (t < ramp_time ? t / ramp_time : 1.0) : 1.0;
+      case Rate:
+        return t;
+      case Table: {
+        if (t <= times.front())
+          return values.front();
+        if (t >= times.back())
+          return values.back();
+        std::size_t k = 1;
+        while (times[k] < t)
+          ++k;
+        const double s = (t - times[k - 1]) / (times[k] - times[k - 1]);
+        return values[k - 1] + s * (values[k] - values[k - 1]);
+      }
+    }
+    return 1.0;
+  }
+  // dg/dt, for the velocity of a prescribed displacement (one-sided at kinks).
+  double rate(double t) const {
+    switch (kind) {
+      case Constant:
+        return 0.0;
+      case Ramp:
+        return (ramp_time > 0 && t < ramp_time) ? 1.0 / ramp_time : 0.0;
+      case Rate:
+        return 1.0;
+      case Table: {
+        if (t < times.front() || t >= times.back())
+          return 0.0;
+        std::size_t k = 1;
+        while (times[k] <= t)
+          ++k;
+        return (values[k] - values[k - 1]) / (times[k] - times[k - 1]);
+      }
+    }
+    return 0.0;
+  }
+};
+
+struct BoundaryCondition {
+  enum Kind {
+    Displacement,
+    Velocity,
+    MicroRotation,
+    Traction,
+    BodyForce,
+    BodyCouple,
+    PorePressure,  // prescribed p [Pa] on the region's points (drained boundary)
+    FluidSource    // water injected [m^3/s; in 2D per metre of thickness], spread by volume
+  };
+  Kind kind = Displacement;
+  std::string name;
+  std::uint32_t region_mask = 0;  // 0: all points
+  int component = 0;              // axis (rotation component for MicroRotation)
+  double value = 0;
+  TimeFunction time;
+  bool kinematic() const {
+    return kind == Displacement || kind == Velocity || kind == MicroRotation;
+  }
+  bool fluid() const { return kind == PorePressure || kind == FluidSource; }
+  // Bit of Points::fixed this condition prescribes.
+  template <int Dim>
+  std::uint32_t fixed_bit() const {
+    return kind == MicroRotation ? 1u << (Dim + component) : 1u << component;
+  }
+};
+
+// Marks the prescribed components of the owned points.
+template <int Dim>
+void mark_fixed(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts) {
+  for (const auto& bc : bcs) {
+    if (!bc.kinematic())
+      continue;
+    const std::uint32_t mask = bc.region_mask, bit = bc.fixed_bit<Dim>();
+    auto regions = pts.regions;
+    auto fixed = pts.fixed;
+    Kokkos::parallel_for(
+        "mupm::BC::mark", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          if (mask == 0 || (regions(i) & mask))
+            fixed(i) |= bit;
+        });
+  }
+}
+
+// Sets the prescribed components at the end of a step from t to t + dt (after the free ones
+// were advanced): displacement u = value g(t+dt), v = value g'(t+dt); velocity
+// u += dt value g(t + dt/2), v = value g(t+dt); micro-rotation theta = value g(t+dt).
+template <int Dim>
+void apply_kinematic(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts, double t,
+                     double dt) {
+  for (const auto& bc : bcs) {
+    if (!bc.kinematic())
+      continue;
+    const std::uint32_t mask = bc.region_mask;
+    const int c = bc.component;
+    auto regions = pts.regions;
+    const double tn = t + dt;
+    if (bc.kind == BoundaryCondition::MicroRotation) {
+      const double th_val = bc.value * bc.time(tn), om_val = bc.value * bc.time.rate(tn);
+      auto th = pts.theta, om = pts.omega, al = pts.alpha;
+      Kokkos::parallel_for(
+          "mupm::BC::rotation", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            if (mask != 0 && !(regions(i) & mask))
+              return;
+            th(i, c) = th_val;
+            om(i, c) = om_val;
+            al(i, c) = 0;
+          });
+      continue;
+    }
+    const bool disp = bc.kind == BoundaryCondition::Displacement;
+    const double u_val = disp ? bc.value * bc.time(tn) : 0.0;
+    const double du = disp ? 0.0 : dt * bc.value * bc.time(t + 0.5 * dt);
+    const double v_val = disp ? bc.value * bc.time.rate(tn) : bc.value * bc.time(tn);
+    auto u = pts.u, v = pts.v, a = pts.a;
+    Kokkos::parallel_for(
+        "mupm::BC::motion", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          if (mask != 0 && !(regions(i) & mask))
+            return;
+          u(i, c) = disp ? u_val : u(i, c) + du;
+          v(i, c) = v_val;
+          a(i, c) = 0;
+        });
+  }
+}
+
+// Body-force density [N/m^3] at time t: body forces on their regions, and tractions [Pa] spread
+// over the points of their region as traction / dx (the region should be the outermost real
+// row of points of the loaded face, one spacing thick).
+// Body couples [N m/m^3] go to `couple` (component = rotation component).
+template <int Dim>
+void body_force_density(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts,
+                        double dx, double t, const Vectors& body, const Vectors& couple) {
+  Kokkos::deep_copy(body, 0.0);
+  Kokkos::deep_copy(couple, 0.0);
+  for (const auto& bc : bcs) {
+    if (bc.kinematic() || bc.fluid())
+      continue;
+    const Vectors target = bc.kind == BoundaryCondition::BodyCouple ? couple : body;
+    const std::uint32_t mask = bc.region_mask;
+    const int c = bc.component;
+    const double b = bc.value * bc.time(t) / (bc.kind == BoundaryCondition::Traction ? dx : 1.0);
+    auto regions = pts.regions;
+    Kokkos::parallel_for(
+        "mupm::BC::body_force", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          if (mask == 0 || (regions(i) & mask))
+            target(i, c) += b;
+        });
+  }
+}
+
+}  // namespace mupm
+
+#endif

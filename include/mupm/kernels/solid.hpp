@@ -1,0 +1,301 @@
+// Stabilized micropolar correspondence kernels (paper eqs 2-9, 43-51, 62-71, 96-112;
+// FORMULATION "Pass 1", "Pass 2", "Stabilization constants").
+//
+// The discrete energy is
+//   Psi = sum_i V_i [ W(eps_i, kappa_i) + 1/2 sum_j (alpha1_ij |R1_ij|^2 + alpha2_ij |R2_ij|^2) V_j
+//   ]
+// with R1_ij = U^_ij - eps_i xi (eq 62), R2_ij = Omega_ij - kappa_i xi (eq 63). The force and
+// moment states are exactly dPsi/dU^ and dPsi/dOmega:
+//   T_ij = omega (sigma_i - S_r p_i 1 - Q1_i) K_i^-1 xi + alpha1_ij R1_ij         (eqs 46, 64)
+//   M_ij = omega (m_i - Q2_i) K_i^-1 xi + alpha2_ij R2_ij                          (eq 65)
+// where Q1_i = sum_j alpha1_ij R1_ij (x) xi V_j and Q2_i likewise. The Q terms are not in the
+// paper's eqs 64-65: they vanish when alpha is the same on every bond of the family (then
+// sum_j omega R (x) xi V_j = 0 by the definition of eps), and for any affine field (R = 0), but
+// alpha ~ 1/|xi|^3 (eq 69) varies over the family, and without them the stabilization forces
+// are not the gradient of any energy: the energy of an undamped run would drift. With them,
+// f_i = sum_j (T_ij - T_ji) V_j and l_i = sum_j (M_ij - M_ji) V_j + 1/2 sum_j xi x (T_ij - T_ji)
+// V_j are -dPsi/du_i / V_i and -dPsi/dtheta_i / V_i, so energy, linear and angular momentum are
+// conserved by the central-difference scheme.
+//
+// Pore pressure in the total stress (undrained split). With a fluid, pass 1 uses
+//   p* = p - (S_r / C) (tr eps - tr eps_ref),
+// the pressure the point would have if no water had flowed since the last fluid update
+// (tr eps_ref; Points::undrained_modulus = S_r / C, zero where p is prescribed or without a
+// fluid). The fluid update then starts from p* and adds the flow
+// (include/mupm/solvers/fluid_solver.hpp). Using p itself (held over the solid step, "drained
+// split") makes the pressure force lag the deformation by a step: with K_w/phi much larger than the
+// skeleton's modulus the central difference is then unconditionally unstable (the lagged stiffness
+// gives a characteristic root product 1 + (omega dt)^2 > 1). With p* the pore water is an undrained
+// stiffness S_r^2 / C of the current state, whose waves the stable-step estimate includes. (Kim,
+// Tchelepi & Juanes 2011 analyse the same splits for implicit coupling.)
+//
+// Kernels only: no MPI; the solver refreshes the ghosts between the passes
+// (include/mupm/solvers/solid_solver.hpp, solid_forces).
+//
+// A point whose intact bonds leave K singular (det K below 1e-6 of a well-conditioned K of the
+// same trace) is "degenerate": eps = kappa = 0 there and its bonds act as the stabilization
+// springs alone (T_ij = alpha1 U^, M_ij = alpha2 Omega): still the gradient of Psi, never NaN.
+#ifndef MUPM_SOLID_HPP
+#define MUPM_SOLID_HPP
+
+#include <cmath>
+#include <vector>
+
+#include "mupm/core/small_matrix.hpp"
+#include "mupm/data/bonds.hpp"
+#include "mupm/data/points.hpp"
+#include "mupm/data/shape_tensors.hpp"
+#include "mupm/laws/micropolar_elastic.hpp"
+#include "mupm/laws/stabilization.hpp"
+
+namespace mupm {
+
+struct SolidParams {
+  MicropolarElastic law;
+  double stabilization = 0.5;  // G in [0, 1] (eqs 66-67)
+  double stab_modulus = 0;     // D (eq 71 or the bulk-matched value), Pa/m^2
+  double horizon_volume = 0;   // volume of a full continuous family (pi delta^2 h, 4/3 pi delta^3)
+};
+
+template <int Dim>
+struct SolidState {
+  static constexpr int R = kRotDim<Dim>;
+  Vectors eps, kappa;  // nonlocal strain and wryness (eqs 50-51), owned + ghosts
+  Vectors P1, P2;      // (sigma - S_r p 1 - Q1) K^-1 and (m - Q2) K^-1, owned + ghosts
+  Scalars w0;          // omega_0 / V_H: the family's share of a full family (eq 68)
+  Bytes degenerate;    // 1 where K is singular
+  Vectors force;       // force density f_i [n_owned][Dim]
+  Vectors moment;      // moment density [n_owned][R]
+  Scalars energy;      // V_i (W_i + stabilization energy density) [n_owned]
+  Scalars pstar;       // p* of this evaluation (undrained split, below) [n_owned]
+
+  void allocate(std::size_t n_all, std::size_t n_owned) {
+    eps = Vectors("mupm::eps", n_all, Dim * Dim);
+    kappa = Vectors("mupm::kappa", n_all, R * Dim);
+    P1 = Vectors("mupm::P1", n_all, Dim * Dim);
+    P2 = Vectors("mupm::P2", n_all, R * Dim);
+    w0 = Scalars("mupm::w0", n_all);
+    degenerate = Bytes("mupm::degenerate", n_all);
+    force = Vectors("mupm::force", n_owned, Dim);
+    moment = Vectors("mupm::moment", n_owned, R);
+    energy = Scalars("mupm::strain_energy", n_owned);
+    pstar = Scalars("mupm::solid_pore_pressure", n_owned);
+  }
+  // What pass 2 reads from the neighbours, besides u and theta.
+  std::vector<Vectors> pass2_ghosts() const { return {eps, kappa, P1, P2, as_vectors(w0)}; }
+};
+
+// Kinematics of bond i -> j (eqs 2-9): xi = x_j - x_i, the composite relative displacement
+// U^ = (u_j - u_i) - Omega-bar x xi with Omega-bar = (theta_i + theta_j)/2, and the relative
+// rotation Omega = theta_j - theta_i. Returns |xi|^2.
+template <int Dim, class X, class U, class T>
+KOKKOS_INLINE_FUNCTION double bond_kinematics(const X& x, const U& u, const T& th, int i, int j,
+                                              double* xi, double* uh, double* om) {
+  constexpr int R = kRotDim<Dim>;
+  double tb[R], c[Dim], len2 = 0;
+  for (int d = 0; d < Dim; ++d) {
+    xi[d] = x(j, d) - x(i, d);
+    len2 += xi[d] * xi[d];
+  }
+  for (int r = 0; r < R; ++r) {
+    tb[r] = 0.5 * (th(i, r) + th(j, r));
+    om[r] = th(j, r) - th(i, r);
+  }
+  rot_cross<Dim>(tb, xi, c);
+  for (int d = 0; d < Dim; ++d)
+    uh[d] = u(j, d) - u(i, d) - c[d];
+  return len2;
+}
+
+// Pass 1 (per owned point): eps, kappa (with K^-1 of the shape-tensor cache), the constitutive
+// update by `law` (sigma-bar, m into pts.stress, pts.couple_stress), Q1, Q2, and the point's
+// energy. Law: a pointwise micropolar law with
+//   KOKKOS_FUNCTION double stress<Dim>(const double* eps, const double* kappa, double* sigma,
+//                                      double* m) const   (returns the energy density W),
+// chosen once by the solver (include/mupm/laws/); MicropolarElastic is eqs 80-81.
+template <int Dim, class Law>
+void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<Dim>& shape,
+                 const SolidParams& prm, const Law& law, SolidState<Dim>& st) {
+  constexpr int R = kRotDim<Dim>;
+  auto offsets = bonds.offsets;
+  auto neighbor = bonds.neighbor;
+  auto intact = bonds.intact;
+  auto x = pts.x, u = pts.u, th = pts.theta;
+  auto vol = pts.volume, p = pts.p, sr = pts.saturation;
+  auto bu = pts.undrained_modulus, ref = pts.vol_strain_ref;
+  auto sigma_v = pts.stress, m_v = pts.couple_stress;
+  auto eps_v = st.eps, kap_v = st.kappa, P1 = st.P1, P2 = st.P2, w0_v = st.w0;
+  auto degen = st.degenerate;
+  auto energy = st.energy;
+  auto pstar = st.pstar;
+  auto Kinv_v = shape.Kinv, fam = shape.family_volume;
+  auto sing = shape.singular;
+  const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;  // G C1 |xi|^3
+  const double c2 = prm.stabilization * prm.stab_modulus;         // G C2 |xi|
+  const double inv_vh = 1.0 / prm.horizon_volume;
+  Kokkos::parallel_for(
+      "mupm::Solid::pass1", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        double A[Dim * Dim] = {}, B[R * Dim] = {};
+        for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
+          if (!intact(b))
+            continue;
+          const int j = neighbor(b);
+          const double vj = vol(j);
+          double xi[Dim], uh[Dim], om[R];
+          bond_kinematics<Dim>(x, u, th, int(i), j, xi, uh, om);
+          for (int a = 0; a < Dim; ++a)
+            for (int k = 0; k < Dim; ++k)
+              A[a * Dim + k] += uh[a] * xi[k] * vj;  // U^ (x) xi (eq 50)
+          for (int r = 0; r < R; ++r)
+            for (int k = 0; k < Dim; ++k)
+              B[r * Dim + k] += om[r] * xi[k] * vj;  // eq 51
+        }
+        double Kinv[Dim * Dim], eps[Dim * Dim] = {}, kap[R * Dim] = {};
+        for (int k = 0; k < Dim * Dim; ++k)
+          Kinv[k] = Kinv_v(i, k);
+        const bool singular = sing(i) != 0;
+        const double wsum = fam(i);
+        if (!singular) {
+          mat_mul<Dim, Dim>(A, Kinv, eps);
+          mat_mul<R, Dim>(B, Kinv, kap);
+        }
+        double sig[Dim * Dim], m[R * Dim];
+        double w = law.template stress<Dim>(eps, kap, sig, m);
+        if (singular)
+          w = 0;
+        const double w0 = wsum * inv_vh;
+        // Stabilization: Q1, Q2 and the energy of the residuals (second bond loop).
+        double Q1[Dim * Dim] = {}, Q2[R * Dim] = {};
+        double ws = 0;
+        if (w0 > 0) {
+          for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
+            if (!intact(b))
+              continue;
+            const int j = neighbor(b);
+            const double vj = vol(j);
+            double xi[Dim], uh[Dim], om[R], r1[Dim], r2[R], ex[Dim], kx[R];
+            const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, uh, om);
+            mat_vec<Dim, Dim>(eps, xi, ex);
+            mat_vec<R, Dim>(kap, xi, kx);
+            const double len = std::sqrt(len2);
+            const double a1 = c1 / (len2 * len * w0), a2 = c2 / (len * w0);  // eqs 66-70
+            for (int d = 0; d < Dim; ++d)
+              r1[d] = uh[d] - ex[d];  // eq 62
+            for (int r = 0; r < R; ++r)
+              r2[r] = om[r] - kx[r];  // eq 63
+            for (int a = 0; a < Dim; ++a) {
+              ws += 0.5 * a1 * r1[a] * r1[a] * vj;
+              for (int k = 0; k < Dim; ++k)
+                Q1[a * Dim + k] += a1 * r1[a] * xi[k] * vj;
+            }
+            for (int r = 0; r < R; ++r) {
+              ws += 0.5 * a2 * r2[r] * r2[r] * vj;
+              for (int k = 0; k < Dim; ++k)
+                Q2[r * Dim + k] += a2 * r2[r] * xi[k] * vj;
+            }
+          }
+        }
+        // Total stress sigma-bar - S_r p* 1 (eq 46) less the stabilization stress, times K^-1.
+        double pe = p(i);
+        if (bu(i) != 0) {
+          double tr_eps = 0;
+          for (int d = 0; d < Dim; ++d)
+            tr_eps += eps[d * Dim + d];
+          pe -= bu(i) * (tr_eps - ref(i));  // undrained split (header)
+        }
+        double S[Dim * Dim], Mm[R * Dim], p1[Dim * Dim], p2[R * Dim];
+        for (int a = 0; a < Dim; ++a)
+          for (int k = 0; k < Dim; ++k)
+            S[a * Dim + k] = sig[a * Dim + k] - (a == k ? sr(i) * pe : 0.0) - Q1[a * Dim + k];
+        for (int k = 0; k < R * Dim; ++k)
+          Mm[k] = m[k] - Q2[k];
+        mat_mul<Dim, Dim>(S, Kinv, p1);
+        mat_mul<R, Dim>(Mm, Kinv, p2);
+        for (int k = 0; k < Dim * Dim; ++k) {
+          eps_v(i, k) = eps[k];
+          P1(i, k) = p1[k];
+          sigma_v(i, k) = sig[k];
+        }
+        for (int k = 0; k < R * Dim; ++k) {
+          kap_v(i, k) = kap[k];
+          P2(i, k) = p2[k];
+          m_v(i, k) = m[k];
+        }
+        w0_v(i) = w0;
+        pstar(i) = pe;
+        degen(i) = singular ? 1 : 0;
+        energy(i) = vol(i) * (w + ws);
+      });
+}
+
+// Pass 2 (per owned point, full neighbour list, no atomics): force and moment densities
+// (eqs 105-112): f_i = sum_j (T_ij - T_ji) V_j,
+// l_i = sum_j (M_ij - M_ji) V_j + 1/2 sum_j xi x (T_ij - T_ji) V_j. Needs the ghosts' u, theta,
+// eps, kappa, P1, P2, w0.
+template <int Dim>
+void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& prm,
+                 SolidState<Dim>& st) {
+  constexpr int R = kRotDim<Dim>;
+  auto offsets = bonds.offsets;
+  auto neighbor = bonds.neighbor;
+  auto intact = bonds.intact;
+  auto x = pts.x, u = pts.u, th = pts.theta;
+  auto vol = pts.volume;
+  auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, w0 = st.w0;
+  auto force = st.force, moment = st.moment;
+  const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
+  const double c2 = prm.stabilization * prm.stab_modulus;
+  Kokkos::parallel_for(
+      "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        double f[Dim] = {}, l[R] = {};
+        for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
+          if (!intact(b))
+            continue;
+          const int j = neighbor(b);
+          const double vj = vol(j);
+          double xi[Dim], Uh[Dim], Om[R];
+          const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, Uh, Om);
+          const double len = std::sqrt(len2);
+          const double a1 = c1 / (len2 * len), a2 = c2 / len;
+          const double a1i = w0(i) > 0 ? a1 / w0(i) : 0.0, a2i = w0(i) > 0 ? a2 / w0(i) : 0.0;
+          const double a1j = w0(j) > 0 ? a1 / w0(j) : 0.0, a2j = w0(j) > 0 ? a2 / w0(j) : 0.0;
+          // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
+          //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
+          double t[Dim];
+          for (int a = 0; a < Dim; ++a) {
+            double pi = 0, pj = 0, ei = 0, ej = 0;
+            for (int k = 0; k < Dim; ++k) {
+              pi += P1(i, a * Dim + k) * xi[k];
+              pj += P1(j, a * Dim + k) * xi[k];
+              ei += eps(i, a * Dim + k) * xi[k];
+              ej += eps(j, a * Dim + k) * xi[k];
+            }
+            t[a] = pi + pj + a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej);
+            f[a] += t[a] * vj;
+          }
+          // M_ij - M_ji, Omega_ji = -Omega_ij.
+          for (int r = 0; r < R; ++r) {
+            double pi = 0, pj = 0, ki = 0, kj = 0;
+            for (int k = 0; k < Dim; ++k) {
+              pi += P2(i, r * Dim + k) * xi[k];
+              pj += P2(j, r * Dim + k) * xi[k];
+              ki += kap(i, r * Dim + k) * xi[k];
+              kj += kap(j, r * Dim + k) * xi[k];
+            }
+            l[r] += (pi + pj + a2i * (Om[r] - ki) + a2j * (Om[r] - kj)) * vj;
+          }
+          double xt[R];
+          cross<Dim>(xi, t, xt);  // 1/2 xi x (T_ij - T_ji)
+          for (int r = 0; r < R; ++r)
+            l[r] += 0.5 * xt[r] * vj;
+        }
+        for (int d = 0; d < Dim; ++d)
+          force(i, d) = f[d];
+        for (int r = 0; r < R; ++r)
+          moment(i, r) = l[r];
+      });
+}
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,65 @@
+// Micropolar (Cosserat) linear elasticity (paper eqs 80-81; FORMULATION "Micropolar
+// Drucker-Prager", elastic law), mixture density (eq 1) and micro-inertia (eq 13).
+#ifndef MUPM_MICROPOLAR_ELASTIC_HPP
+#define MUPM_MICROPOLAR_ELASTIC_HPP
+
+#include <Kokkos_Core.hpp>
+
+#include "mupm/core/types.hpp"
+
+namespace mupm {
+
+struct MicropolarElastic {
+  double lambda = 0;  // Lame constant [Pa]
+  double mu = 0;      // shear modulus [Pa]
+  double mu_c = 0;    // micropolar (Cosserat) shear modulus [Pa]
+  double length = 0;  // micropolar length scale l [m]
+
+  static MicropolarElastic from_bulk_shear(double K, double mu, double mu_c, double l) {
+    return {K - 2.0 * mu / 3.0, mu, mu_c, l};
+  }
+  double young() const { return mu * (3 * lambda + 2 * mu) / (lambda + mu); }
+  double poisson() const { return lambda / (2 * (lambda + mu)); }
+  // Couple-stress modulus B of m = B kappa: eq 81, m_ij = 1/2 mu l^2 kappa_ij.
+  KOKKOS_INLINE_FUNCTION double couple_modulus() const { return 0.5 * mu * length * length; }
+
+  // sigma-bar_ij = lambda eps_kk delta_ij + (mu + mu_c) eps_ij + (mu - mu_c) eps_ji (eq 80),
+  // m = B kappa (eq 81). eps is Dim x Dim, kappa RotDim x Dim, both row-major. Returns the
+  // strain energy density W = 1/2 (sigma : eps + m : kappa).
+  template <int Dim>
+  KOKKOS_INLINE_FUNCTION double stress(const double* eps, const double* kappa, double* sigma,
+                                       double* m) const {
+    constexpr int R = kRotDim<Dim>;
+    double tr = 0;
+    for (int d = 0; d < Dim; ++d)
+      tr += eps[d * Dim + d];
+    double w = 0;
+    for (int a = 0; a < Dim; ++a)
+      for (int b = 0; b < Dim; ++b) {
+        const double s = (a == b ? lambda * tr : 0.0) + (mu + mu_c) * eps[a * Dim + b] +
+                         (mu - mu_c) * eps[b * Dim + a];
+        sigma[a * Dim + b] = s;
+        w += 0.5 * s * eps[a * Dim + b];
+      }
+    const double B = couple_modulus();
+    for (int k = 0; k < R * Dim; ++k) {
+      m[k] = B * kappa[k];
+      w += 0.5 * m[k] * kappa[k];
+    }
+    return w;
+  }
+};
+
+// Mixture density rho = (1 - phi) rho_s + S_r phi rho_w (eq 1).
+KOKKOS_INLINE_FUNCTION double mixture_density(double phi, double rho_s, double sr, double rho_w) {
+  return (1.0 - phi) * rho_s + sr * phi * rho_w;
+}
+
+// Micro-inertia density J = (pi/2)(1 - phi) rho_s l^2 (eq 13).
+KOKKOS_INLINE_FUNCTION double micro_inertia(double phi, double rho_s, double l) {
+  return 0.5 * kPi * (1.0 - phi) * rho_s * l * l;
+}
+
+}  // namespace mupm
+
+#endif

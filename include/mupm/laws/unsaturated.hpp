@@ -1,0 +1,53 @@
+// Unsaturated pore water: van Genuchten retention (paper eq 12) and Mualem relative
+// permeability (eq 56), as a small value type usable inside kernels. FORMULATION "Fluid".
+//
+// Pore pressure p is positive in compression, negative (suction s = -p) when unsaturated;
+// passive pore air (p_a = 0):
+//   S_r(p) = [1 + (-p / s_a)^n]^(-m)   for p < 0,     S_r = 1 for p >= 0      (eq 12)
+//   k_r(S_r) = S_r^(1/2) [1 - (1 - S_r^(1/m))^m]^2                           (eq 56)
+// The paper does not tie m to n; the input default is Mualem's m = 1 - 1/n.
+#ifndef MUPM_UNSATURATED_HPP
+#define MUPM_UNSATURATED_HPP
+
+#include <cmath>
+
+#include "mupm/core/types.hpp"
+
+namespace mupm {
+
+struct VanGenuchten {
+  bool enabled = false;    // false: saturated everywhere (S_r = 1, k_r = 1, dS_r/dp = 0)
+  double air_entry = 1e4;  // s_a [Pa]
+  double n = 2;
+  double m = 0.5;
+
+  // Mualem's m = 1 - 1/n.
+  static VanGenuchten mualem(double air_entry, double n) { return {true, air_entry, n, 1 - 1 / n}; }
+
+  KOKKOS_INLINE_FUNCTION double saturation(double p) const {
+    if (!enabled || p >= 0)
+      return 1.0;
+    return std::pow(1 + std::pow(-p / air_entry, n), -m);
+  }
+  // dS_r/dp = m n (s/s_a)^(n-1) [1 + (s/s_a)^n]^(-m-1) / s_a with s = -p (>= 0: drying lowers
+  // S_r as p falls).
+  KOKKOS_INLINE_FUNCTION double dsaturation_dp(double p) const {
+    if (!enabled || p >= 0)
+      return 0.0;
+    const double s = -p / air_entry;
+    const double sn = std::pow(s, n);
+    return m * n * std::pow(s, n - 1) * std::pow(1 + sn, -m - 1) / air_entry;
+  }
+  KOKKOS_INLINE_FUNCTION double relative_permeability(double sr) const {
+    if (!enabled || sr >= 1)
+      return 1.0;
+    if (!(sr > 0))
+      return 0.0;
+    const double a = 1 - std::pow(1 - std::pow(sr, 1 / m), m);
+    return std::sqrt(sr) * a * a;
+  }
+};
+
+}  // namespace mupm
+
+#endif

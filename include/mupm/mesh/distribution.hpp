@@ -1,0 +1,52 @@
+// Distribution of points over MPI ranks with Tpetra: an owned map by global id, an overlap map
+// (owned first, then the ghosts within the horizon), one persistent Import, and a ghost refresh
+// that packs several per-point fields into one MultiVector (one message per neighbour rank).
+#ifndef MUPM_DISTRIBUTION_HPP
+#define MUPM_DISTRIBUTION_HPP
+
+#include <Teuchos_Comm.hpp>
+#include <Teuchos_RCP.hpp>
+#include <Tpetra_Import.hpp>
+#include <Tpetra_Map.hpp>
+#include <Tpetra_MultiVector.hpp>
+#include <vector>
+
+#include "mupm/core/types.hpp"
+
+namespace mupm {
+
+using Map = Tpetra::Map<LocalId, GlobalId>;
+using Import = Tpetra::Import<LocalId, GlobalId>;
+using MultiVector = Tpetra::MultiVector<double, LocalId, GlobalId>;
+using Comm = Teuchos::Comm<int>;
+
+class Distribution {
+ public:
+  Distribution() = default;
+  Distribution(const Teuchos::RCP<const Comm>& comm, const std::vector<GlobalId>& owned,
+               const std::vector<GlobalId>& ghosts);
+
+  const Teuchos::RCP<const Comm>& comm() const { return comm_; }
+  const Teuchos::RCP<const Map>& owned_map() const { return owned_map_; }
+  const Teuchos::RCP<const Map>& overlap_map() const { return overlap_map_; }
+  std::size_t n_owned() const { return n_owned_; }
+  std::size_t n_ghost() const { return n_ghost_; }
+  GlobalId n_global() const { return static_cast<GlobalId>(owned_map_->getGlobalNumElements()); }
+
+  // Copies the owned rows of every field (each [n_owned + n_ghost][ncomp]) into the ghost rows
+  // of the other ranks that need them. Fields of one call travel together in one MultiVector.
+  void refresh(const std::vector<Vectors>& fields);
+  std::size_t refresh_count() const { return refresh_count_; }
+
+ private:
+  Teuchos::RCP<const Comm> comm_;
+  Teuchos::RCP<const Map> owned_map_, overlap_map_;
+  Teuchos::RCP<const Import> importer_;
+  std::size_t n_owned_ = 0, n_ghost_ = 0, refresh_count_ = 0;
+  // Buffers kept between calls of the same width to avoid re-allocation every step.
+  Teuchos::RCP<MultiVector> owned_buf_, overlap_buf_;
+};
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,392 @@
+// The fluid step of Algorithm 1: prescribed pore pressure and sources, the flow kernels of
+// include/mupm/kernels/fluid.hpp, the explicit pressure update (eqs 141-146, beta_3 = 0), fluid
+// mass and boundary inflow bookkeeping, and the stable-step estimate.
+//
+// Coupling with the solid (staggered): the solid writes tr(eps) of every owned point into
+// Points::vol_strain whenever it evaluates its forces. A fluid update over an interval dt_total
+// takes the rate (vol_strain - vol_strain_ref) / dt_total, then sets vol_strain_ref =
+// vol_strain. Solid first: the interval is the solid steps just taken. Fluid first: it is the
+// previous interval (the first update of a run sees no change).
+//
+// Mass bookkeeping: fluid_content m_i starts as phi S_r (1 + p/K_w) and every step adds
+// C dp + S_r d(tr eps), which by the mass balance equals dt (s_i - div_i) on free points. On a
+// prescribed-pressure point the reservoir supplies what the balance needs,
+//   supply_i = V_i (C dp + S_r d(tr eps) + dt div_i - dt s_i),
+// and sum_i V_i div_i = 0 (each bond's flow appears with both signs), so
+//   rho_w sum_i V_i m_i (t) - rho_w sum_i V_i m_i (0) = inflow through pressure conditions +
+//   injected water, to round-off. The test FluidSolver.MassConservation checks both.
+//
+// Energy (eqs 147-149, in power form): multiplying the mass balance by p gives
+//   d/dt sum V psi(p) = -sum V S_r p dV_s/dt - sum V p div + sum V p s + sum p supply,
+// psi the stored energy density (include/mupm/kernels/fluid.hpp). The update books the flow
+// dissipation D and the external work W_ext (sources and reservoirs) with the pressure at the
+// start of each step (the rate forward Euler uses), and the coupling work W_c (the water's
+// work on the skeleton) with the step's mean pressure (the undrained response to a volume
+// change is exact, not a forward-Euler rate). With constant C the balance
+// E_s(t) - E_s(0) + W_c + D - W_ext then differs from zero by sum V dp dt (s - div) / 2 per
+// step: the forward-Euler error of the flow alone, first order in dt for a smooth evolution and
+// growing without bound when the step is unstable. The driver checks it against
+// Solver->Energy Tolerance like the solid's (eq 149).
+#ifndef MUPM_FLUID_SOLVER_HPP
+#define MUPM_FLUID_SOLVER_HPP
+
+#include <mpi.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mupm/kernels/boundary_conditions.hpp"
+#include "mupm/kernels/fluid.hpp"
+#include "mupm/mesh/discretization.hpp"
+#include "mupm/solvers/module.hpp"
+#include "mupm/solvers/power_iteration.hpp"
+
+namespace mupm {
+
+// Pass 1, ghost refresh, pass 2 for the pressure field p (owned + ghosts current).
+template <int Dim>
+void fluid_flow(Discretization<Dim>& disc, const FluidParams& prm, FluidState<Dim>& st,
+                const Scalars& p, bool with_gravity = true) {
+  ScopedRegion region("mupm::Fluid::flow");
+  fluid_pass1(disc.points, disc.bonds, disc.shape, prm, st, p, with_gravity);
+  disc.dist.refresh(st.pass2_ghosts());
+  fluid_pass2(disc.points, disc.bonds, st, p);
+}
+
+template <int Dim>
+class FluidSolver : public Module {
+ public:
+  FluidSolver(Discretization<Dim>& disc, const FluidParams& prm, std::vector<BoundaryCondition> bcs,
+              MPI_Comm comm)
+      : disc_(disc), prm_(prm), comm_(comm) {
+    for (auto& bc : bcs)
+      if (bc.fluid())
+        bcs_.push_back(bc);
+    auto& p = disc_.points;
+    st_.allocate(p.size(), p.n_owned);
+    source_ = Scalars("mupm::fluid_source", p.n_owned);
+    supply_ = Scalars("mupm::fluid_supply", p.n_owned);
+    inflow_.assign(bcs_.size(), 0.0);
+    region_volume_.assign(bcs_.size(), 0.0);
+  }
+
+  const FluidState<Dim>& state() const { return st_; }
+  const FluidParams& params() const { return prm_; }
+
+  struct Energy {
+    double stored = 0, stored0 = 0, coupling_work = 0, dissipation = 0, external_work = 0;
+    double balance() const {
+      return stored - stored0 + coupling_work + dissipation - external_work;
+    }
+    double scale() const {
+      return std::max(std::max(std::abs(stored - stored0), std::abs(coupling_work)),
+                      std::max(std::abs(dissipation), std::abs(external_work)));
+    }
+  };
+  Energy energy() const {
+    Energy e = energy_;
+    e.stored = stored_energy();
+    return e;
+  }
+
+  const char* name() const override { return "fluid"; }
+  // For restarts: the cumulative water mass [kg] that entered through each fluid condition,
+  // then the energy terms booked so far.
+  void globals(GlobalRefs& g) override {
+    for (std::size_t k = 0; k < bcs_.size(); ++k)
+      g("inflow_" + bcs_[k].name, inflow_[k]);
+    g("stored_energy_initial", energy_.stored0);
+    g("coupling_work", energy_.coupling_work);
+    g("dissipation", energy_.dissipation);
+    g("external_work", energy_.external_work);
+  }
+  void series(SeriesRow& row) const override {
+    const auto e = energy();
+    row("fluid_stored_energy", e.stored - e.stored0);
+    row("fluid_coupling_work", e.coupling_work);
+    row("fluid_dissipation", e.dissipation);
+    row("fluid_external_work", e.external_work);
+    row("fluid_energy_error", e.balance());
+    row("fluid_mass", fluid_mass());
+    for (std::size_t k = 0; k < bcs_.size(); ++k)
+      row("fluid_inflow_" + bcs_[k].name, inflow_[k]);
+  }
+  // Energy balance (eqs 147-149, include/mupm/solvers/fluid_solver.hpp header).
+  std::vector<EnergyBalance> energy_balances() const override {
+    const auto e = energy();
+    return {{"fluid", "E_s - E_s0 + W_c + D - W_ext", std::abs(e.balance()), e.scale()}};
+  }
+  const std::vector<double>& inflows() const { return inflow_; }
+
+  // Marks prescribed pressures; at a start (not a restart) sets them at t, the fluid content
+  // and the volumetric-strain reference; computes S_r, k_r, C and the flow of the state.
+  // A solid initialized afterwards computes tr(eps): then call reset_strain_reference().
+  void initialize(double t, bool restarted) {
+    auto& p = disc_.points;
+    auto regions = p.regions;
+    auto fixed = p.fixed, vol = p.volume;
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      const std::uint32_t mask = bcs_[k].region_mask;
+      if (bcs_[k].kind == BoundaryCondition::PorePressure)
+        Kokkos::parallel_for(
+            "mupm::Fluid::mark", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+              if (mask == 0 || (regions(i) & mask))
+                fixed(i) |= kFixedPressure;
+            });
+      double v = 0;
+      Kokkos::parallel_reduce(
+          "mupm::Fluid::region_volume", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& s) {
+            if (mask == 0 || (regions(i) & mask))
+              s += vol(i);
+          },
+          v);
+      MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_SUM, comm_);
+      region_volume_[k] = v;
+    }
+    if (!restarted) {
+      set_pressure(t, p.p);
+      energy_.stored0 = stored_energy();
+      fluid_constitutive(p, prm_, st_);
+      auto pw = p.p, phi = p.porosity, sr = p.saturation, m = p.fluid_content;
+      auto vs = p.vol_strain, ref = p.vol_strain_ref;
+      const double inv_kw = 1.0 / prm_.bulk_modulus;
+      Kokkos::parallel_for(
+          "mupm::Fluid::content", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            m(i) = phi(i) * sr(i) * (1 + pw(i) * inv_kw);
+            ref(i) = vs(i);
+          });
+    }
+    evaluate();
+  }
+
+  void reset_strain_reference() {
+    auto& p = disc_.points;
+    Kokkos::deep_copy(Kokkos::subview(p.vol_strain_ref, std::make_pair(std::size_t(0), p.n_owned)),
+                      Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
+  }
+
+  // Advances p from t over `substeps` equal steps spanning dt_total, with the solid's volume
+  // change since the last update spread evenly over them.
+  void advance(double t, double dt_total, int substeps) {
+    ScopedRegion region("mupm::Fluid::advance");
+    const double dt = dt_total / substeps;
+    for (int k = 0; k < substeps; ++k)
+      substep(t + k * dt, dt, dt_total);
+    reset_strain_reference();
+  }
+
+  // Water mass in the body [kg]: rho_w sum_i V_i m_i.
+  double fluid_mass() const {
+    const auto& p = disc_.points;
+    auto m = p.fluid_content, vol = p.volume;
+    double s = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::mass", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += m(i) * vol(i); }, s);
+    MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return prm_.water_density * s;
+  }
+
+  // sum_i V_i psi(p_i) [J].
+  double stored_energy() const {
+    const auto& p = disc_.points;
+    auto pw = p.p, phi = p.porosity, vol = p.volume;
+    const VanGenuchten vg = prm_.retention;
+    const double inv_kw = 1.0 / prm_.bulk_modulus;
+    double s = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::stored_energy", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          acc += vol(i) * stored_energy_density(vg, phi(i), inv_kw, pw(i));
+        },
+        s);
+    MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return s;
+  }
+
+  // Largest S_r^2 / C over the points: the pore water's contribution to the undrained bulk
+  // modulus (K_w / phi when saturated), for the solid's stable step.
+  double undrained_stiffening() const {
+    const auto& p = disc_.points;
+    auto sr = p.saturation;
+    auto C = st_.storage;
+    double m = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::undrained", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          const double v = C(i) > 0 ? sr(i) * sr(i) / C(i) : 0.0;
+          acc = v > acc ? v : acc;
+        },
+        Kokkos::Max<double>(m));
+    MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    return m;
+  }
+
+  // Largest stable forward-Euler step 2 / lambda_max of C dp/dt = -L p (L: the flow operator at
+  // the current k_r and C, prescribed pressures held), by power iteration with the
+  // C-weighted Rayleigh quotient (from below).
+  double estimate_stable_dt(int iterations = 40) {
+    ScopedRegion region("mupm::Fluid::stable_step");
+    auto& p = disc_.points;
+    Scalars x("mupm::fluid_power_iterate", p.size());
+    const Operator op{x, st_.flow, st_.storage, p.fixed};
+    const double lambda = largest_eigenvalue(
+        op, 1, p.n_owned, p.gid, p.volume,
+        [&] {
+          disc_.dist.refresh({as_vectors(x)});
+          fluid_flow(disc_, prm_, st_, x, false);
+        },
+        comm_, iterations);
+    evaluate();
+    return lambda > 0 ? 2.0 / lambda : 0.0;
+  }
+
+ private:
+  // C^-1 L of the power iteration: the iterate is a pressure field, L x its flow divergence,
+  // M = C; prescribed pressures (and points without storage) held.
+  struct Operator {
+    Scalars xv, flow, C;
+    Flags fixed;
+    KOKKOS_INLINE_FUNCTION double& x(std::size_t i, int) const { return xv(i); }
+    KOKKOS_INLINE_FUNCTION double ax(std::size_t i, int) const { return flow(i); }
+    KOKKOS_INLINE_FUNCTION double mass(std::size_t i, int) const { return C(i); }
+    KOKKOS_INLINE_FUNCTION bool held(std::size_t i, int) const {
+      return (fixed(i) & kFixedPressure) || !(C(i) > 0);
+    }
+    KOKKOS_INLINE_FUNCTION double start(std::size_t i, int, double s) const {
+      return (fixed(i) & kFixedPressure) ? 0.0 : std::sin(1.3 * s) + 0.1;
+    }
+  };
+
+  // S_r, k_r, C and the flow of the current pressure. Only p is read on the ghosts (k_r of a
+  // neighbour reaches pass 2 inside its alpha).
+  void evaluate() {
+    auto& p = disc_.points;
+    fluid_constitutive(p, prm_, st_);
+    disc_.dist.refresh({as_vectors(p.p)});
+    fluid_flow(disc_, prm_, st_, p.p);
+  }
+
+  // p = value g(t) on the points of every pressure condition (later conditions win).
+  void set_pressure(double t, const Scalars& target) {
+    auto& p = disc_.points;
+    auto regions = p.regions;
+    for (const auto& bc : bcs_) {
+      if (bc.kind != BoundaryCondition::PorePressure)
+        continue;
+      const std::uint32_t mask = bc.region_mask;
+      const double v = bc.value * bc.time(t);
+      Kokkos::parallel_for(
+          "mupm::Fluid::pressure_bc", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            if (mask == 0 || (regions(i) & mask))
+              target(i) = v;
+          });
+    }
+  }
+
+  // One forward-Euler step from t to t + dt (eqs 141-146). evaluate() has run for the state at t.
+  void substep(double t, double dt, double dt_total) {
+    auto& p = disc_.points;
+    const double h = Dim == 2 ? disc_.grid.thickness : 1.0;
+    auto regions = p.regions;
+    // Sources [1/s]: rate g(t) (per metre of thickness in 2D) over the region's volume.
+    Kokkos::deep_copy(source_, 0.0);
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      const auto& bc = bcs_[k];
+      if (bc.kind != BoundaryCondition::FluidSource || !(region_volume_[k] > 0))
+        continue;
+      const std::uint32_t mask = bc.region_mask;
+      const double s = bc.value * bc.time(t) * h / region_volume_[k];
+      auto src = source_;
+      Kokkos::parallel_for(
+          "mupm::Fluid::source", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            if (mask == 0 || (regions(i) & mask))
+              src(i) += s;
+          });
+      inflow_[k] += prm_.water_density * bc.value * bc.time(t) * h * dt;
+    }
+    // Prescribed pressures at t + dt go to supply_ first (the target), then the update.
+    auto target = supply_;
+    Kokkos::deep_copy(target, 0.0);
+    set_pressure(t + dt, target);
+    auto pw = p.p, rate = p.p_rate, sr = p.saturation, m = p.fluid_content, vol = p.volume;
+    auto vs = p.vol_strain, ref = p.vol_strain_ref;
+    auto fixed = p.fixed;
+    auto C = st_.storage, flow = st_.flow, src = source_;
+    const double inv_total = 1.0 / dt_total;
+    double w[3] = {0, 0, 0};  // coupling work, flow dissipation, external work (energy_ doc)
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::update", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& wc, double& wd, double& we) {
+          const double dv = (vs(i) - ref(i)) * inv_total * dt;  // eq 117 over this step
+          const double rhs = -sr(i) * dv + dt * (src(i) - flow(i));
+          double dp;
+          const double p0 = pw(i);
+          if (fixed(i) & kFixedPressure) {
+            dp = target(i) - p0;
+            target(i) = vol(i) * (C(i) * dp - rhs);  // what the reservoir supplies [m^3]
+          } else {
+            dp = C(i) > 0 ? rhs / C(i) : 0.0;  // eq 143
+            target(i) = 0;
+          }
+          wc += vol(i) * (p0 + 0.5 * dp) * sr(i) * dv;
+          wd += vol(i) * p0 * dt * flow(i);
+          we += vol(i) * p0 * dt * src(i) + p0 * target(i);
+          m(i) += C(i) * dp + sr(i) * dv;
+          rate(i) = dp / dt;
+          pw(i) = p0 + dp;  // eq 145, beta_3 = 0
+        },
+        w[0], w[1], w[2]);
+    std::vector<double> supplied(bcs_.size() + 3, 0.0);
+    supplied[bcs_.size()] = w[0];
+    supplied[bcs_.size() + 1] = w[1];
+    supplied[bcs_.size() + 2] = w[2];
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      if (bcs_[k].kind != BoundaryCondition::PorePressure)
+        continue;
+      // Points of several pressure conditions count for the last one (set_pressure's order).
+      std::uint32_t later = 0;
+      bool later_all = false;
+      for (std::size_t l = k + 1; l < bcs_.size(); ++l)
+        if (bcs_[l].kind == BoundaryCondition::PorePressure) {
+          later |= bcs_[l].region_mask;
+          later_all = later_all || bcs_[l].region_mask == 0;
+        }
+      if (later_all)
+        continue;
+      const std::uint32_t mask = bcs_[k].region_mask;
+      double s = 0;
+      Kokkos::parallel_reduce(
+          "mupm::Fluid::inflow", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+            if ((mask == 0 || (regions(i) & mask)) && !(regions(i) & later))
+              acc += target(i);
+          },
+          s);
+      supplied[k] = s;
+    }
+    // One reduction for all conditions and the energy terms.
+    MPI_Allreduce(MPI_IN_PLACE, supplied.data(), int(supplied.size()), MPI_DOUBLE, MPI_SUM, comm_);
+    for (std::size_t k = 0; k < bcs_.size(); ++k)
+      inflow_[k] += prm_.water_density * supplied[k];
+    energy_.coupling_work += supplied[bcs_.size()];
+    energy_.dissipation += supplied[bcs_.size() + 1];
+    energy_.external_work += supplied[bcs_.size() + 2];
+    evaluate();
+  }
+
+  Discretization<Dim>& disc_;
+  FluidParams prm_;
+  MPI_Comm comm_;
+  std::vector<BoundaryCondition> bcs_;
+  FluidState<Dim> st_;
+  Scalars source_, supply_;
+  std::vector<double> inflow_, region_volume_;
+  Energy energy_;
+};
+
+}  // namespace mupm
+
+#endif

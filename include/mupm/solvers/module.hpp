@@ -1,0 +1,73 @@
+// A physics module of the driver (solid, fluid, damage; later fracture, J-integral, plasticity,
+// second-order work): what it adds to the time series, which scalars it keeps across a restart,
+// and the energy balances it checks. Each declares these once, name and value together.
+#ifndef MUPM_MODULE_HPP
+#define MUPM_MODULE_HPP
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace mupm {
+
+// One row of time_series.csv: column names and values added together, in order. The header is
+// the names of the first row.
+class SeriesRow {
+ public:
+  void operator()(const std::string& column, double value) {
+    names_.push_back(column);
+    values_.push_back(value);
+  }
+  const std::vector<std::string>& names() const { return names_; }
+  const std::vector<double>& values() const { return values_; }
+
+ private:
+  std::vector<std::string> names_;
+  std::vector<double> values_;
+};
+
+// The named scalars a module keeps across a restart (cumulative work, inflows...): the
+// checkpoint stores each as globals/<module>/<name> and a restart puts it back by name.
+class GlobalRefs {
+ public:
+  void operator()(const std::string& name, double& value) { refs_.push_back({name, &value}); }
+  const std::vector<std::pair<std::string, double*>>& refs() const { return refs_; }
+
+ private:
+  std::vector<std::pair<std::string, double*>> refs_;
+};
+
+// One energy balance: |error| should stay below Solver->Energy Tolerance x scale.
+struct EnergyBalance {
+  std::string what;        // "solid", "fluid"
+  std::string expression;  // the balance as a formula, for the message
+  double error = 0;        // the balance's value [J]
+  double scale = 0;        // the largest of its terms [J]
+};
+
+class Module {
+ public:
+  virtual ~Module() = default;
+  // Prefix of the module's restart globals.
+  virtual const char* name() const = 0;
+  // Columns and values of the time series (collective: may reduce over ranks).
+  virtual void series(SeriesRow&) const {}
+  // Restart globals (references to the module's own members).
+  virtual void globals(GlobalRefs&) {}
+  // Energy balances to check after each step (collective).
+  virtual std::vector<EnergyBalance> energy_balances() const { return {}; }
+};
+
+// What advances u and theta in a step (the micropolar solid, or kinematics alone).
+class Mechanics : public Module {
+ public:
+  virtual void step(double t, double dt) = 0;
+  // Largest stable step of the explicit scheme (0: no limit).
+  virtual double stable_time_step() { return 0.0; }
+  // Mixture density and micro-inertia after the fluid changed the saturation (eq 1).
+  virtual void update_density() {}
+};
+
+}  // namespace mupm
+
+#endif

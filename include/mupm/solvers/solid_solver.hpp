@@ -1,0 +1,420 @@
+// The solid step of Algorithm 1 for the elastic micropolar solid: boundary conditions, forces,
+// central difference, energy bookkeeping (eqs 137-140), reactions, stable-step estimate.
+#ifndef MUPM_SOLID_SOLVER_HPP
+#define MUPM_SOLID_SOLVER_HPP
+
+#include <mpi.h>
+
+#include <cmath>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "mupm/kernels/boundary_conditions.hpp"
+#include "mupm/kernels/central_difference.hpp"
+#include "mupm/kernels/solid.hpp"
+#include "mupm/mesh/discretization.hpp"
+#include "mupm/solvers/module.hpp"
+#include "mupm/solvers/power_iteration.hpp"
+
+namespace mupm {
+
+// Pass 1, ghost refresh, pass 2: the force and moment densities of the current u, theta, p.
+// u, theta (and p, S_r) must be current on the ghosts.
+template <int Dim, class Law>
+void solid_forces(Discretization<Dim>& disc, const SolidParams& prm, const Law& law,
+                  SolidState<Dim>& st) {
+  ScopedRegion region("mupm::Solid::forces");
+  solid_pass1(disc.points, disc.bonds, disc.shape, prm, law, st);
+  disc.dist.refresh(st.pass2_ghosts());
+  solid_pass2(disc.points, disc.bonds, prm, st);
+}
+// The same with the elastic law of prm.
+template <int Dim>
+void solid_forces(Discretization<Dim>& disc, const SolidParams& prm, SolidState<Dim>& st) {
+  solid_forces(disc, prm, prm.law, st);
+}
+
+// Law: the pointwise constitutive law of pass 1 (include/mupm/kernels/solid.hpp), chosen once
+// by the driver from Materials->Model.
+template <int Dim, class Law = MicropolarElastic>
+class SolidSolver : public Mechanics {
+ public:
+  static constexpr int R = kRotDim<Dim>;
+
+  struct Settings {
+    double rho_s = 2000, rho_w = 1000;
+    Kokkos::Array<double, 3> gravity{};
+    double damping = 0;
+  };
+  struct Energy {
+    double internal = 0, kinetic = 0, external_work = 0, dissipation = 0;
+    // Work of the pore water on the skeleton: sum over steps of sum_i V_i S_r p* d(tr eps_i)
+    // (the -S_r p* 1 part of the total stress, eq 46; p* linear in tr eps within a step, so the
+    // trapezoid rule is exact).
+    double pore_work = 0;
+    // E_int + E_kin + D - W_ext - W_pore, which the scheme keeps constant (eq 140).
+    double balance() const { return internal + kinetic + dissipation - external_work - pore_work; }
+    double scale() const {
+      return std::max(
+          std::max(std::abs(internal), kinetic),
+          std::max(std::max(std::abs(external_work), dissipation), std::abs(pore_work)));
+    }
+  };
+
+  SolidSolver(Discretization<Dim>& disc, const SolidParams& prm, std::vector<BoundaryCondition> bcs,
+              const Settings& settings, MPI_Comm comm, const Law& law = Law())
+      : disc_(disc), prm_(prm), law_(law), bcs_(std::move(bcs)), set_(settings), comm_(comm) {
+    if constexpr (std::is_same_v<Law, MicropolarElastic>)
+      law_ = prm.law;
+    auto& p = disc_.points;
+    st_.allocate(p.size(), p.n_owned);
+    rho_ = Scalars("mupm::density", p.n_owned);
+    inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
+    body_ = Vectors("mupm::body_force", p.n_owned, Dim);
+    couple_ = Vectors("mupm::body_couple", p.n_owned, R);
+    du_ = Vectors("mupm::step_increment", p.n_owned, Dim + R);
+    vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
+  }
+
+  const SolidState<Dim>& state() const { return st_; }
+  const SolidParams& params() const { return prm_; }
+  const Scalars& density() const { return rho_; }
+
+  const char* name() const override { return "solid"; }
+  // Work of the boundary and body forces, damping dissipation and pore work since t = 0, and
+  // the balance at t = 0 (eq 140 keeps E_int + E_kin + D - W_ext - W_pore at it).
+  void globals(GlobalRefs& g) override {
+    g("external_work", work_);
+    g("dissipation", dissipation_);
+    g("pore_pressure_work", pore_work_);
+    g("initial_balance", balance0_);
+  }
+  void series(SeriesRow& row) const override {
+    const auto e = energy();
+    row("internal_energy", e.internal);
+    row("kinetic_energy", e.kinetic);
+    row("external_work", e.external_work);
+    row("dissipation", e.dissipation);
+    row("pore_pressure_work", e.pore_work);
+    row("energy_error", e.balance() - balance0_);
+    const auto names = reaction_names();
+    const auto values = reactions();
+    for (std::size_t k = 0; k < names.size(); ++k)
+      row(names[k], values[k]);
+  }
+  // Energy balance (eqs 137-140).
+  std::vector<EnergyBalance> energy_balances() const override {
+    const auto e = energy();
+    return {{"solid", "E_int + E_kin + D - W_ext - W_pore - E_0", std::abs(e.balance() - balance0_),
+             e.scale()}};
+  }
+
+  // Mixture density (eq 1) and micro-inertia (eq 13) from the current porosity and saturation.
+  void update_density() override {
+    auto& p = disc_.points;
+    auto phi = p.porosity, sr = p.saturation;
+    auto rho = rho_, J = inertia_;
+    const double rho_s = set_.rho_s, rho_w = set_.rho_w, l = prm_.law.length;
+    Kokkos::parallel_for(
+        "mupm::Solid::density", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          rho(i) = mixture_density(phi(i), rho_s, sr(i), rho_w);
+          J(i) = micro_inertia(phi(i), rho_s, l);
+        });
+  }
+
+  // Marks prescribed components, computes densities (eqs 1, 13) from porosity and saturation,
+  // and the forces of the current state; at a start (not a restart, whose state holds them)
+  // also the boundary values at t and the accelerations.
+  void initialize(double t, bool restarted) {
+    auto& p = disc_.points;
+    mark_fixed(bcs_, p);
+    update_density();
+    if (!restarted)
+      apply_kinematic(bcs_, p, t, 0.0);
+    disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
+    forces(t);
+    // Points::solid_pressure is the p* of the forces last applied (the pore work of the next
+    // step starts from it); a restart has it from the checkpoint, not from the pressure the
+    // fluid has updated since.
+    if (!restarted) {
+      keep_applied_pressure();
+      advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
+                         0.0, 0.0);
+      balance0_ = energy().balance();
+    }
+  }
+
+  // One step from t to t + dt.
+  void step(double t, double dt) override {
+    ScopedRegion region("mupm::Solid::step");
+    auto& p = disc_.points;
+    save_positions();
+    advance_positions(p, dt);
+    apply_kinematic(bcs_, p, t, dt);
+    increments();
+    // Work, dissipation and pore work of the step (this rank's points), then one reduction.
+    double w[3] = {0.5 * power(), 0, 0};  // old forces on the increment (trapezoid, first half)
+    Kokkos::deep_copy(vs_old_,
+                      Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
+    forces(t + dt);
+    w[0] += 0.5 * power();  // new forces (second half)
+    w[1] = dt * damping_power();
+    w[2] = pore_power();
+    keep_applied_pressure();
+    MPI_Allreduce(MPI_IN_PLACE, w, 3, MPI_DOUBLE, MPI_SUM, comm_);
+    work_ += w[0];
+    dissipation_ += w[1];
+    pore_work_ += w[2];
+    advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
+                       set_.damping, dt);
+  }
+
+  Energy energy() const {
+    const auto& p = disc_.points;
+    auto en = st_.energy;
+    auto v = p.v, om = p.omega;
+    auto vol = p.volume;
+    auto fixed = p.fixed;
+    auto rho = rho_, J = inertia_;
+    double e[2] = {0, 0};
+    Kokkos::parallel_reduce(
+        "mupm::Solid::energy", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& ei, double& ek) {
+          ei += en(i);
+          const std::uint32_t fx = fixed(i);
+          for (int k = 0; k < Dim; ++k)
+            if (!(fx & (1u << k)))
+              ek += 0.5 * rho(i) * vol(i) * v(i, k) * v(i, k);
+          for (int r = 0; r < R; ++r)
+            if (!(fx & (1u << (Dim + r))))
+              ek += 0.5 * J(i) * vol(i) * om(i, r) * om(i, r);
+        },
+        e[0], e[1]);
+    MPI_Allreduce(MPI_IN_PLACE, e, 2, MPI_DOUBLE, MPI_SUM, comm_);
+    return {e[0], e[1], work_, dissipation_, pore_work_};
+  }
+
+  // Force (moment) the boundary applies on each kinematic condition's points: -sum f V.
+  std::vector<std::string> reaction_names() const {
+    std::vector<std::string> n;
+    for (const auto& bc : bcs_)
+      if (bc.kinematic())
+        n.push_back("reaction_" + bc.name);
+    return n;
+  }
+  std::vector<double> reactions() const {
+    std::vector<double> out;
+    const auto& p = disc_.points;
+    for (const auto& bc : bcs_) {
+      if (!bc.kinematic())
+        continue;
+      const bool rot = bc.kind == BoundaryCondition::MicroRotation;
+      const Vectors f = rot ? st_.moment : st_.force;
+      const int c = bc.component;
+      const std::uint32_t mask = bc.region_mask;
+      auto regions = p.regions;
+      auto vol = p.volume;
+      double s = 0;
+      Kokkos::parallel_reduce(
+          "mupm::Solid::reaction", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+            if (mask == 0 || (regions(i) & mask))
+              acc -= f(i, c) * vol(i);
+          },
+          s);
+      MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
+      out.push_back(s);
+    }
+    return out;
+  }
+
+  // Largest stable step of the undamped central difference, 2 / omega_max, with omega_max^2
+  // the largest eigenvalue of M^-1 K of the discrete operator (prescribed components held),
+  // by power iteration with the mass-weighted Rayleigh quotient (it approaches omega_max^2
+  // from below). The state is restored afterwards.
+  // With a fluid the operator includes the undrained stiffness S_r^2 / C of the undrained split
+  // (include/mupm/kernels/solid.hpp): the fastest waves are the undrained ones.
+  double stable_time_step() override { return estimate_stable_dt(); }
+  double estimate_stable_dt(int iterations = 40) {
+    ScopedRegion region("mupm::Solid::stable_step");
+    auto& p = disc_.points;
+    const std::size_t n = p.size();
+    Vectors u0("u0", n, Dim), t0("t0", n, R);
+    Kokkos::deep_copy(u0, p.u);
+    Kokkos::deep_copy(t0, p.theta);
+    Scalars p0("p0", n), ref0("ref0", n);
+    Kokkos::deep_copy(p0, p.p);
+    Kokkos::deep_copy(ref0, p.vol_strain_ref);
+    Kokkos::deep_copy(p.p, 0.0);  // the operator's linear part only
+    Kokkos::deep_copy(p.vol_strain_ref, 0.0);
+    const Operator op{p.u, p.theta, st_.force, st_.moment, rho_, inertia_, p.fixed};
+    const double lambda = largest_eigenvalue(
+        op, Dim + R, p.n_owned, p.gid, p.volume,
+        [&] {
+          disc_.dist.refresh({p.u, p.theta});
+          solid_forces(disc_, prm_, law_, st_);
+        },
+        comm_, iterations);
+    Kokkos::deep_copy(p.u, u0);
+    Kokkos::deep_copy(p.theta, t0);
+    Kokkos::deep_copy(p.p, p0);
+    Kokkos::deep_copy(p.vol_strain_ref, ref0);
+    disc_.dist.refresh({p.u, p.theta});
+    solid_forces(disc_, prm_, law_, st_);
+    return lambda > 0 ? 2.0 / std::sqrt(lambda) : 0.0;
+  }
+
+ private:
+  // M^-1 K of the power iteration: the iterate is (u, theta), K x = -(f, l) (prescribed
+  // components held), M = (rho, J).
+  struct Operator {
+    Vectors u, th, f, l;
+    Scalars rho, J;
+    Flags fixed;
+    KOKKOS_INLINE_FUNCTION double& x(std::size_t i, int c) const {
+      return c < Dim ? u(i, c) : th(i, c - Dim);
+    }
+    KOKKOS_INLINE_FUNCTION double ax(std::size_t i, int c) const {
+      return c < Dim ? -f(i, c) : -l(i, c - Dim);
+    }
+    KOKKOS_INLINE_FUNCTION double mass(std::size_t i, int c) const {
+      return c < Dim ? rho(i) : J(i);
+    }
+    KOKKOS_INLINE_FUNCTION bool held(std::size_t i, int c) const {
+      return (fixed(i) & (1u << c)) != 0;
+    }
+    KOKKOS_INLINE_FUNCTION double start(std::size_t i, int c, double s) const {
+      if (held(i, c))
+        return 0.0;
+      return c < Dim ? std::sin(1.3 * s + 0.7 * c) + 0.1 : std::cos(0.9 * s + 0.3 * (c - Dim));
+    }
+  };
+
+  void forces(double t) {
+    auto& p = disc_.points;
+    disc_.dist.refresh({p.u, p.theta});
+    solid_forces(disc_, prm_, law_, st_);
+    body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
+    auto eps = st_.eps;
+    auto vs = p.vol_strain;
+    Kokkos::parallel_for(
+        "mupm::Solid::volumetric_strain", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          double tr = 0;
+          for (int d = 0; d < Dim; ++d)
+            tr += eps(i, d * Dim + d);
+          vs(i) = tr;  // eq 117
+        });
+  }
+
+  void keep_applied_pressure() {
+    auto& p = disc_.points;
+    Kokkos::deep_copy(Kokkos::subview(p.solid_pressure, std::make_pair(std::size_t(0), p.n_owned)),
+                      st_.pstar);
+  }
+
+  // sum_i V_i S_r (p*_old + p*_new)/2 (tr eps_new - tr eps_old) of this step (this rank's
+  // points; step() sums over ranks), with the p* the forces were evaluated with: the old one
+  // is from before any fluid update in between, as the first half of the velocity update
+  // used it (trapezoid rule on the applied forces, like the external work).
+  double pore_power() const {
+    const auto& p = disc_.points;
+    auto vs = p.vol_strain, sr = p.saturation, vol = p.volume;
+    auto ps = st_.pstar, ps_old = p.solid_pressure;
+    auto old = vs_old_;
+    double w = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::pore_work", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          acc += vol(i) * sr(i) * 0.5 * (ps(i) + ps_old(i)) * (vs(i) - old(i));
+        },
+        w);
+    return w;
+  }
+
+  void save_positions() {
+    auto& p = disc_.points;
+    auto u = p.u, th = p.theta, du = du_;
+    Kokkos::parallel_for(
+        "mupm::Solid::save", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          for (int k = 0; k < Dim; ++k)
+            du(i, k) = u(i, k);
+          for (int r = 0; r < R; ++r)
+            du(i, Dim + r) = th(i, r);
+        });
+  }
+  void increments() {
+    auto& p = disc_.points;
+    auto u = p.u, th = p.theta, du = du_;
+    Kokkos::parallel_for(
+        "mupm::Solid::increment", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          for (int k = 0; k < Dim; ++k)
+            du(i, k) = u(i, k) - du(i, k);
+          for (int r = 0; r < R; ++r)
+            du(i, Dim + r) = th(i, r) - du(i, Dim + r);
+        });
+  }
+  // Power of the external agents on this step's increment: on prescribed components the
+  // boundary holds the point against the body's force density f (it applies -f V); on free
+  // components gravity and the body/traction forces act.
+  double power() const {
+    const auto& p = disc_.points;
+    auto f = st_.force, l = st_.moment, b = body_, bc = couple_, du = du_;
+    auto vol = p.volume;
+    auto fixed = p.fixed;
+    auto rho = rho_;
+    const auto g = set_.gravity;
+    double w = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::external_work", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          const std::uint32_t fx = fixed(i);
+          for (int k = 0; k < Dim; ++k)
+            acc += ((fx & (1u << k)) ? -f(i, k) : b(i, k) + rho(i) * g[k]) * du(i, k) * vol(i);
+          for (int r = 0; r < R; ++r)
+            acc += ((fx & (1u << (Dim + r))) ? -l(i, r) : bc(i, r)) * du(i, Dim + r) * vol(i);
+        },
+        w);
+    return w;
+  }
+  // Damping power c (rho v.v + J omega.omega) V at the half step (this rank's points).
+  double damping_power() const {
+    if (set_.damping == 0)
+      return 0.0;
+    const auto& p = disc_.points;
+    auto v = p.v, om = p.omega, vol = p.volume;
+    auto fixed = p.fixed;
+    auto rho = rho_, J = inertia_;
+    const double c = set_.damping;
+    double w = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::damping_power", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          const std::uint32_t fx = fixed(i);
+          for (int k = 0; k < Dim; ++k)
+            if (!(fx & (1u << k)))
+              acc += c * rho(i) * v(i, k) * v(i, k) * vol(i);
+          for (int r = 0; r < R; ++r)
+            if (!(fx & (1u << (Dim + r))))
+              acc += c * J(i) * om(i, r) * om(i, r) * vol(i);
+        },
+        w);
+    return w;
+  }
+
+  Discretization<Dim>& disc_;
+  SolidParams prm_;
+  Law law_;
+  std::vector<BoundaryCondition> bcs_;
+  Settings set_;
+  MPI_Comm comm_;
+  SolidState<Dim> st_;
+  Scalars rho_, inertia_;
+  Vectors body_, couple_, du_;
+  Scalars vs_old_;
+  double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
+};
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,53 @@
+// The step of Algorithm 1, written once: the mechanics (the micropolar solid, or kinematics
+// alone) advances u and theta, then bond breakage and damage, then the fluid; with Staggering =
+// Fluid First the fluid comes before the mechanics instead (FORMULATION "Time integration").
+// The fluid advances once every `fluid_every` steps over their combined interval, in `substeps`
+// equal steps:
+//   Solid First: the solid steps with p held; after the last solid step of an interval the
+//     fluid advances over it with the volume change those steps made.
+//   Fluid First: at the start of an interval the fluid advances with the volume change of the
+//     previous interval; then the solid steps with the new p.
+// After each fluid update the mixture density follows the new saturation (eq 1).
+#ifndef MUPM_STEP_SEQUENCE_HPP
+#define MUPM_STEP_SEQUENCE_HPP
+
+#include "mupm/solvers/damage.hpp"
+#include "mupm/solvers/fluid_solver.hpp"
+#include "mupm/solvers/module.hpp"
+
+namespace mupm {
+
+template <int Dim>
+struct StepSequence {
+  Mechanics* mechanics = nullptr;  // none: the fluid alone (rigid skeleton)
+  FluidSolver<Dim>* fluid = nullptr;
+  Damage<Dim>* damage = nullptr;  // bond breakage and damage (fracture)
+  bool fluid_first = false;
+  int fluid_every = 1;
+  int substeps = 1;
+
+  // Step number `step` (0-based, counted from t = 0 so restarts keep the intervals), t -> t + dt.
+  void step(long long step, double t, double dt) {
+    const double interval = fluid_every * dt;
+    if (fluid && fluid_first && step % fluid_every == 0)
+      advance_fluid(t, interval);
+    if (mechanics)
+      mechanics->step(t, dt);
+    if (damage)
+      damage->update();
+    // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
+    if (fluid && !fluid_first && (step + 1) % fluid_every == 0)
+      advance_fluid(mechanics ? t + dt - interval : t, interval);
+  }
+
+ private:
+  void advance_fluid(double t, double interval) {
+    fluid->advance(t, interval, substeps);
+    if (mechanics)
+      mechanics->update_density();
+  }
+};
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,918 @@
+#include "mupm/input/input.hpp"
+
+#include "mupm/data/points.hpp"
+#include "mupm/input/options.hpp"
+
+#include <Teuchos_Array.hpp>
+#include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <Teuchos_StringInputSource.hpp>
+#include <Teuchos_XMLObject.hpp>
+#include <Teuchos_XMLParameterListCoreHelpers.hpp>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace mupm {
+
+namespace {
+
+using Teuchos::Array;
+using Teuchos::ParameterList;
+using Teuchos::RCP;
+using Teuchos::rcp;
+
+// Initial Conditions->NAME->Field: the registry's settable fields (include/mupm/data/points.hpp),
+// then the hydrostatic pressure, which is not a field value.
+const char* const kHydrostatic = kHydrostaticPorePressure;
+std::vector<std::string> ic_fields() {
+  std::vector<std::string> out;
+  for (const auto& s : Points<3>::specs())
+    if (s.initial_condition)
+      out.push_back(s.initial_condition);
+  out.push_back(kHydrostatic);
+  return out;
+}
+// Components of a settable field in a `dim`-dimensional body (0: not settable).
+int ic_components(const std::string& field, int dim) {
+  if (field == kHydrostatic)
+    return dim;
+  const auto specs = dim == 2 ? Points<2>::specs() : Points<3>::specs();
+  for (const auto& s : specs)
+    if (s.initial_condition && field == s.initial_condition)
+      return s.ncomp;
+  return 0;
+}
+std::string joined(const std::vector<std::string>& v) {
+  std::string out;
+  for (std::size_t k = 0; k < v.size(); ++k)
+    out += (k == 0 ? "" : k + 1 == v.size() ? " or " : ", ") + v[k];
+  return out;
+}
+const std::vector<std::string> kFaces = {"-x", "+x", "-y", "+y", "-z", "+z"};
+
+template <class T>
+RCP<Teuchos::EnhancedNumberValidator<T>> at_least(T lo) {
+  return rcp(new Teuchos::EnhancedNumberValidator<T>(lo, std::numeric_limits<T>::max()));
+}
+RCP<Teuchos::EnhancedNumberValidator<double>> positive() {
+  return at_least(std::numeric_limits<double>::min());
+}
+RCP<Teuchos::StringValidator> one_of(const std::vector<std::string>& v) {
+  return rcp(new Teuchos::StringValidator(Array<std::string>(v.begin(), v.end())));
+}
+
+void region_template(ParameterList& r) {
+  r.set("Min", Array<double>(), "Lower corner of the box [m] (Dim values, closed).");
+  r.set("Max", Array<double>(), "Upper corner of the box [m] (Dim values, closed).");
+}
+void crack_template(ParameterList& c) {
+  c.set("Start", Array<double>(), "2D: first end of the crack segment [m].");
+  c.set("End", Array<double>(), "2D: second end of the crack segment [m].");
+  c.set("Corner", Array<double>(), "3D: a corner of the crack rectangle [m].");
+  c.set("Edge 1", Array<double>(), "3D: first edge vector of the rectangle from Corner [m].");
+  c.set("Edge 2", Array<double>(),
+        "3D: second edge vector of the rectangle from Corner [m], orthogonal to Edge 1.");
+}
+void ic_template(ParameterList& c) {
+  c.set("Field", std::string("Velocity"),
+        "Field to set: " + joined(ic_fields()) +
+            ". Value holds one entry per component: Displacement, Velocity: Dim; Micro-Rotation, "
+            "Micro-Rotation Rate: 1 in 2D, 3 in 3D; Pore Pressure, Fracture Pressure [Pa], "
+            "Porosity, Saturation: 1 (with a fluid physics S_r follows from the pressure "
+            "instead). Hydrostatic Pore Pressure: p = rho_w g . (x - x_0) with g = "
+            "Solver->Gravity and Value = x_0, a point of the water table (Dim values).",
+        one_of(ic_fields()));
+  c.set("Region", std::string("All"),
+        "Name of a region of Discretization->Regions, or All. Later conditions overwrite "
+        "earlier ones where they overlap.");
+  c.set("Value", Array<double>(), "The value (number of entries as Field says).");
+}
+
+void bc_template(ParameterList& c) {
+  c.set("Type", std::string("Displacement"),
+        "Displacement [m], Velocity [m/s] or Micro-Rotation [rad] prescribed on the region's "
+        "points (the boundary-layer method: use a boundary layer region), or Traction [Pa] "
+        "applied as a body force traction/dx on the region's points (make it the outermost real "
+        "row of the face), or Body Force [N/m^3], or Body Couple [N m/m^3] (Component: the "
+        "rotation axis). Fluid (Solver->Physics = Pore Fluid or Hydro-Mechanical): Pore "
+        "Pressure [Pa] prescribed on the region's points (a drained boundary; boundaries "
+        "without one are impervious), or Fluid Source: water injected at Value [m^3/s; in 2D "
+        "m^3/s per metre of thickness] spread over the region's points by volume (a point "
+        "source: a region holding one point; a line: a one-row region; negative: extraction). "
+        "Component is ignored by the fluid conditions.",
+        boundary_condition_options().validator());
+  c.set("Region", std::string("All"), "Region name (Discretization->Regions, 'Layer -y', All).");
+  c.set("Component", std::string("x"),
+        "x, y or z: the displacement/velocity/traction/force component, or the rotation axis "
+        "(2D micro-rotation: z).",
+        component_options().validator());
+  c.set("Value", 0.0, "The value, times the time function.");
+  c.set("Time Function", std::string("Constant"),
+        "Constant: Value. Ramp: Value * min(t / Ramp Time, 1). Rate: Value * t. Table: Value * "
+        "the piecewise-linear table (Times, Values), held constant outside it.",
+        time_function_options().validator());
+  c.set("Ramp Time", 0.0, "Ramp duration [s] (Time Function = Ramp).", at_least(0.0));
+  c.set("Times", Array<double>(), "Table times [s], increasing (Time Function = Table).");
+  c.set("Values", Array<double>(), "Table values (Time Function = Table), as many as Times.");
+}
+
+// The user-named sublists: validated against their template one by one, not by Teuchos'
+// recursion.
+const std::vector<std::pair<std::string, void (*)(ParameterList&)>> kNamedSublists = {
+    {"Regions", region_template}, {"Pre-Cracks", crack_template}};
+
+}  // namespace
+
+const std::vector<std::string>& output_field_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const auto& s : Points<3>::specs())
+      if (s.has(kOutput))
+        n.push_back(s.name);
+    return n;
+  }();
+  return names;
+}
+
+RCP<ParameterList> valid_parameters() {
+  auto pl = rcp(new ParameterList("mupm"));
+  {
+    ParameterList& d = pl->sublist("Discretization", false,
+                                   "The point grid: a box of cell-centred points of spacing "
+                                   "Spacing, boundary layers, pre-cracks and named regions.");
+    d.set("Dimension", 2, "2 (plane strain) or 3.",
+          rcp(new Teuchos::EnhancedNumberValidator<int>(2, 3)));
+    d.set("Spacing", 1.0, "Point spacing dx [m] (required, > 0).", positive());
+    d.set("Counts", Array<int>(),
+          "Number of points of the real body along each axis (Dim values >= 1). Give Counts "
+          "or Extents.",
+          rcp(new Teuchos::ArrayNumberValidator<int>(at_least(1))));
+    d.set("Extents", Array<double>(),
+          "Size of the real body along each axis [m] (Dim values, each a whole multiple of "
+          "Spacing). Give Counts or Extents.");
+    d.set("Origin", Array<double>(), "Lower corner of the real body [m] (Dim values; default 0).");
+    d.set("Horizon Factor", 3.015,
+          "Horizon delta as a multiple of Spacing (used unless Horizon is given).", positive());
+    d.set("Horizon", 0.0, "Horizon delta [m]; 0: use Horizon Factor. Give one of the two.",
+          at_least(0.0));
+    d.set("Thickness", 1.0, "Out-of-plane thickness [m] (2D only).", positive());
+    d.set("Boundary Layer Horizons", 2.0,
+          "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
+          "default) gives the layer points next to the body full families too, which the "
+          "correspondence model needs for exact boundary values; the paper's layers are 1.",
+          positive());
+    d.set("Boundary Layers", Array<std::string>(),
+          "Faces of the body that get a boundary layer of fictitious points outside them (the "
+          "paper's boundary-layer method), any of -x +x -y +y -z +z. "
+          "Each layer is also a region named 'Layer -y' etc.",
+          rcp(new Teuchos::ArrayStringValidator(one_of(kFaces))));
+    ParameterList& r = d.sublist("Regions", false,
+                                 "Named boxes for boundary and initial conditions and outputs: "
+                                 "one sublist per region, named as you like (at most 24).");
+    region_template(r.sublist("NAME"));
+    ParameterList& c = d.sublist("Pre-Cracks", false,
+                                 "Initial cracks, one sublist each: a segment (Start, End) in 2D, "
+                                 "a rectangle (Corner, Edge 1, Edge 2) in 3D. Bonds crossing a "
+                                 "crack start broken; points closer than Spacing to it start as "
+                                 "fracture points.");
+    crack_template(c.sublist("NAME"));
+  }
+  {
+    ParameterList& m =
+        pl->sublist("Materials", false, "The solid (Solver->Physics = Micropolar Solid).");
+    m.set("Model", std::string("Micropolar Elastic"),
+          "Constitutive model: Micropolar Elastic (eqs 80-81).",
+          constitutive_model_options().validator());
+    m.set("Bulk Modulus", 0.0, "Drained bulk modulus K [Pa] (> 0 for a solid).", at_least(0.0));
+    m.set("Shear Modulus", 0.0, "Shear modulus mu [Pa] (> 0 for a solid).", at_least(0.0));
+    m.set("Micropolar Shear Modulus", 0.0, "Cosserat coupling modulus mu_c [Pa] (eq 80).",
+          at_least(0.0));
+    m.set("Length Scale", 0.0,
+          "Micropolar length scale l [m] (> 0 for a solid): couple-stress modulus mu l^2/2 "
+          "(eq 81) and micro-inertia (pi/2)(1 - phi) rho_s l^2 (eq 13).",
+          at_least(0.0));
+    m.set("Solid Density", 2000.0, "Density of the solid grains rho_s [kg/m^3].", positive());
+    m.set("Porosity", 0.0, "Initial porosity phi (0 <= phi < 1); Initial Conditions may override.",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 0.999999)));
+    m.set("Stabilization", 0.5, "Stabilization parameter G in [0, 1] (eqs 66-67).",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1.0)));
+    m.set(
+        "Stabilization Modulus", std::string("Automatic"),
+        "D of eqs 69-71. Eq 71: the paper's 3D D = E(1-4nu)/(4 pi delta^2 (1-nu-2nu^2)), "
+        "negative for nu > 1/4, then an error. Bulk Matching: D = 3K/(8 pi delta^2) in 3D, "
+        "(lambda+mu)/(6 pi h delta) in 2D (stabilization energy of a uniform expansion equal "
+        "to the elastic one; derivation in include/mupm/kernels/solid.hpp). Automatic: Eq 71 in 3D "
+        "where it is positive, Bulk Matching otherwise and always in 2D.",
+        stabilization_modulus_options().validator());
+  }
+  {
+    ParameterList& f = pl->sublist(
+        "Fluid", false,
+        "Pore water (Solver->Physics = Pore Fluid or Hydro-Mechanical; Water Density always).");
+    f.set("Water Density", 1000.0, "rho_w [kg/m^3], in the mixture density (eq 1).", positive());
+    f.set("Fluid Bulk Modulus", 2.2e9,
+          "K_w [Pa]: storage C = phi dS_r/dp + phi S_r / K_w. Saturated points store water by "
+          "its compressibility alone; an explicit scheme cannot take K_w -> infinity "
+          "(incompressible water), and its stable steps shrink as K_w grows (the solid's by "
+          "the undrained modulus K + K_w/phi, the fluid's with C).",
+          positive());
+    f.set("Intrinsic Permeability", 0.0,
+          "k [m^2] (with Viscosity). Give either this or Hydraulic Conductivity, not both.",
+          at_least(0.0));
+    f.set("Viscosity", 1e-3,
+          "Dynamic viscosity of water mu_w [Pa s] (with Intrinsic Permeability).", positive());
+    f.set("Hydraulic Conductivity", 0.0,
+          "K_h [m/s], the paper's 'hydraulic conductivity k_w': converted by k/mu_w = K_h / "
+          "(rho_w g_0), g_0 = 9.80665 m/s^2 (whatever Solver->Gravity is). Give either this "
+          "or Intrinsic Permeability, not both.",
+          at_least(0.0));
+    f.set("Retention Model", std::string("Saturated"),
+          "Saturated: S_r = 1, k_r = 1 at any pressure. Van Genuchten: S_r = [1 + (-p/s_a)^n]^-m "
+          "for p < 0 (eq 12), Mualem k_r = S_r^1/2 [1 - (1 - S_r^(1/m))^m]^2 (eq 56).",
+          retention_model_options().validator());
+    f.set("Air Entry Pressure", 1e4, "s_a [Pa] of eq 12 (Van Genuchten).", positive());
+    f.set("Van Genuchten n", 2.0, "n of eq 12 (> 1).", positive());
+    f.set("Van Genuchten m", 0.0, "m of eqs 12 and 56 in (0, 1); 0: Mualem's m = 1 - 1/n.",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 0.999999)));
+    f.set("Flow Stabilization", 0.5,
+          "G in [0, 1] of the flow stabilization (eqs 72-78): bond-wise diffusion of the "
+          "non-uniform part of p that damps checkerboard pressure modes; G = 1 gives bond "
+          "conductances equal to the uniform-weight bond-based model's (derivation in "
+          "include/mupm/kernels/fluid.hpp).",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1.0)));
+    f.set("Gravity In Darcy Flux", true,
+          "Darcy's law with gravity, q = -(k_r k / mu_w)(grad p - rho_w g) with g = "
+          "Solver->Gravity (eq 54); false: q = -(k_r k / mu_w) grad p.");
+  }
+  pl->sublist("Fracture", false, "Bond breakage and fracture flow (filled by the fracture issue).");
+  {
+    ParameterList& b =
+        pl->sublist("Boundary Conditions", false, "One sublist per condition, named as you like.");
+    bc_template(b.sublist("NAME"));
+  }
+
+  {
+    ParameterList& ic = pl->sublist("Initial Conditions", false,
+                                    "Initial fields, one sublist per condition, named as you "
+                                    "like, applied in the order given.");
+    ic_template(ic.sublist("NAME"));
+  }
+  {
+    ParameterList& s = pl->sublist("Solver", false, "Time stepping.");
+    s.set("Physics", std::string("Micropolar Solid"),
+          "Physics advanced each step. Micropolar Solid: the stabilized micropolar "
+          "correspondence solid (Materials), explicit central difference. Kinematics Only: no "
+          "internal forces (points move with their velocity); damage from intact bonds (eq 37) "
+          "either way. Pore Fluid: unsaturated flow in a rigid skeleton (Fluid), explicit in "
+          "p. Hydro-Mechanical: both, staggered (Staggering), coupled by the total stress "
+          "sigma-bar - S_r p 1 (eq 46), the mixture density (eq 1) and the volume change rate "
+          "(eq 117).",
+          physics_options().validator());
+    s.set("Staggering", std::string("Solid First"),
+          "Order of the staggered step (Hydro-Mechanical). Solid First: the solid steps with "
+          "the pressure held, then the fluid with the volume change they made. Fluid First: the "
+          "fluid steps with the previous interval's volume change, then the solid with the new "
+          "pressure (fluid-driven problems). Both agree as Time Step -> 0.",
+          staggering_options().validator());
+    s.set("Solid Steps Per Fluid Step", 1,
+          "Hydro-Mechanical: the fluid advances once every this many solid steps, over their "
+          "combined interval (a larger fluid step when flow is slow).",
+          at_least(1));
+    s.set("Fluid Substeps", 1,
+          "Equal fluid steps per fluid interval (sub-cycling when flow is faster than the "
+          "solid); 0: as many as Time Step Safety Factor x the estimated stable fluid step "
+          "requires. With Physics = Pore Fluid the interval is Time Step (Automatic Time Step "
+          "sets it to the safety factor x the stable fluid step).",
+          at_least(0));
+    s.set("Time Step", 1e-6, "Time step dt [s] (> 0).", positive());
+    s.set("Automatic Time Step", false,
+          "Use Time Step Safety Factor x the estimated stable step instead of Time Step.");
+    s.set("Time Step Safety Factor", 0.5,
+          "Fraction of the estimated stable step (power iteration on the discrete operator) used "
+          "by Automatic Time Step, and the limit above which Time Step draws a warning.",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(1e-6, 1.0)));
+    s.set("Gravity", Array<double>(),
+          "Gravitational acceleration [m/s^2] (Dim values; default 0).");
+    s.set("Damping", 0.0,
+          "Mass-proportional damping c [1/s] (a = f/rho - c v), for quasi-static runs by dynamic "
+          "relaxation; 0: none.",
+          at_least(0.0));
+    s.set("Energy Tolerance", 1e-2,
+          "Largest accepted |E_int + E_kin + D - W_ext - W_pore - E_0| (solid, eqs 137-140) and "
+          "|E_s - E_s0 + W_c + D_f - W_ext,f| (fluid, eqs 147-149) relative to the largest of "
+          "their terms; beyond it a warning with the step.",
+          at_least(0.0));
+    s.set("Stop On Energy Violation", false, "Stop the run when the energy balance is violated.");
+    s.set("Energy Check Start", 20,
+          "Steps after the start (or a restart) before the energy balances are checked: in the "
+          "first steps from rest every term is tiny and the scheme's start-up error (forward "
+          "Euler weighs the first fluid step with p = 0; the first solid steps of a ramped load) "
+          "is of the same size as the terms.",
+          at_least(0));
+    s.set("Number of Steps", 100, "Number of time steps (>= 0).", at_least(0));
+    s.set("Restart From", std::string(""),
+          "Checkpoint file (.h5) to continue from; empty: start at t = 0. The run may use a "
+          "different number of ranks and threads than the one that wrote it.");
+  }
+  {
+    ParameterList& o = pl->sublist("Output", false, "Files written to Output->Folder.");
+    o.set("Folder", std::string("output"), "Output folder (created if missing).");
+    o.set("Field Interval", 10,
+          "Steps between point-field outputs (HDF5 + XDMF); 0: first and last step only.",
+          at_least(0));
+    o.set("Fields", Array<std::string>({"displacement", "velocity", "damage", "fracture"}),
+          "Point fields written at each field output. Any of: " + joined(output_field_names()) +
+              ". Global id and reference position are always written.",
+          rcp(new Teuchos::ArrayStringValidator(one_of(output_field_names()))));
+    o.set("Time Series Interval", 1, "Steps between rows of time_series.csv (>= 1).", at_least(1));
+    o.set("Checkpoint Interval", 0, "Steps between checkpoints; 0: none during the run.",
+          at_least(0));
+    o.set("Checkpoint At End", true, "Write a checkpoint after the last step.");
+    o.set("Progress Interval", 5.0,
+          "Wall-clock seconds between progress lines (step, time, ETA); 0: every step.",
+          at_least(0.0));
+  }
+  {
+    ParameterList& g = pl->sublist("Diagnostics", false, "Checks and reports.");
+    g.set("Kernel Timers", true,
+          "Print the per-kernel time table (min/max over ranks) at the end of the run.");
+    g.set("Check Finite", true,
+          "Stop the run when a field holds NaN or Inf, naming the step, global id and position.");
+  }
+  return pl;
+}
+
+namespace {
+
+std::string path_of(const ParameterList& list, const std::string& name) {
+  return list.name() + "->" + name;
+}
+
+// Teuchos' messages name the (sub)list and the entry and list what is valid; keep them, and
+// drop the preamble and the "Throw number" trailer.
+std::string clean_teuchos(const std::exception& e) {
+  std::string msg = e.what();
+  const auto pos = msg.find("Error");
+  if (pos != std::string::npos && pos > 0)
+    msg = msg.substr(pos);
+  const auto tr = msg.find("Throw number");
+  if (tr != std::string::npos)
+    msg = msg.substr(0, tr);
+  while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' '))
+    msg.pop_back();
+  return msg;
+}
+
+// The XML reader names the root "ANONYMOUS"; give every list its full path from "mupm".
+void name_lists(ParameterList& list, const std::string& path) {
+  list.setName(path);
+  for (auto it = list.begin(); it != list.end(); ++it)
+    if (list.entry(it).isList())
+      name_lists(list.sublist(list.name(it)), path + "->" + list.name(it));
+}
+
+void validate_level(ParameterList& list, const ParameterList& valid) {
+  // Sublists whose children are user-named are checked entry by entry against "NAME".
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string& name = list.name(it);
+    const auto* ventry = valid.getEntryPtr(name);
+    if (ventry && ventry->isList() && list.entry(it).isList() &&
+        Teuchos::getValue<ParameterList>(*ventry).isSublist("NAME")) {
+      ParameterList& user = list.sublist(name);
+      const ParameterList& tmpl = Teuchos::getValue<ParameterList>(*ventry).sublist("NAME");
+      for (auto jt = user.begin(); jt != user.end(); ++jt) {
+        const std::string& child = user.name(jt);
+        if (!user.entry(jt).isList())
+          throw InputError("Error, " + path_of(user, child) +
+                           " is a parameter, but here every entry must be a sublist (one per "
+                           "named item) with the parameters: " +
+                           tmpl.currentParametersString());
+        validate_level(user.sublist(child), tmpl);
+      }
+    }
+  }
+  // This level: names, types and ranges (Teuchos), then defaults; recursion into the fixed
+  // sublists below.
+  ParameterList shallow(valid.name());
+  for (auto it = valid.begin(); it != valid.end(); ++it) {
+    const std::string& name = valid.name(it);
+    if (valid.entry(it).isList()) {
+      ParameterList& s = shallow.sublist(name);
+      if (Teuchos::getValue<ParameterList>(valid.entry(it)).isSublist("NAME"))
+        s.disableRecursiveValidation();
+    } else {
+      shallow.setEntry(name, valid.entry(it));
+    }
+  }
+  // Validators' own messages do not say where the entry is: add its full path.
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const auto* ventry = valid.getEntryPtr(list.name(it));
+    if (!ventry || ventry->isList() || list.entry(it).isList())
+      continue;
+    const auto& any = list.entry(it).getAny(false);
+    if (any.type() != ventry->getAny(false).type())
+      throw InputError("Error, " + path_of(list, list.name(it)) + " has type \"" + any.typeName() +
+                       "\" (value \"" + Teuchos::toString(any) + "\"); the expected type is \"" +
+                       ventry->getAny(false).typeName() + "\": " + ventry->docString());
+    if (ventry->validator().is_null())
+      continue;
+    try {
+      ventry->validator()->validate(list.entry(it), list.name(it), list.name());
+    } catch (const std::exception& e) {
+      throw InputError("Error, " + path_of(list, list.name(it)) + " = " +
+                       Teuchos::toString(list.entry(it).getAny(false)) +
+                       " is not valid. Expected: " + ventry->docString() + "\n" + clean_teuchos(e));
+    }
+  }
+  try {
+    list.validateParameters(shallow, 0);
+  } catch (const std::exception& e) {
+    throw InputError(clean_teuchos(e));
+  }
+  for (auto it = valid.begin(); it != valid.end(); ++it) {
+    const std::string& name = valid.name(it);
+    if (!valid.entry(it).isList()) {
+      // A filled-in default is marked as such (isDefault), without the validator, so the
+      // resolved list written back is plain values.
+      if (!list.isParameter(name)) {
+        Teuchos::ParameterEntry e;
+        e.setAnyValue(valid.entry(it).getAny(false), true);
+        e.setDocString(valid.entry(it).docString());
+        list.setEntry(name, e);
+      }
+      continue;
+    }
+    ParameterList& sub = list.sublist(name);
+    const ParameterList& vsub = Teuchos::getValue<ParameterList>(valid.entry(it));
+    if (vsub.isSublist("NAME"))
+      continue;  // children checked above
+    validate_level(sub, vsub);
+  }
+}
+
+template <class T>
+Array<T> get_array(const ParameterList& l, const std::string& name, std::size_t n,
+                   const std::string& what) {
+  Array<T> a = l.get<Array<T>>(name);
+  if (static_cast<std::size_t>(a.size()) != n) {
+    std::ostringstream s;
+    s << "Error, " << path_of(l, name) << " must hold " << n << " values (" << what << "), not "
+      << a.size() << ".";
+    throw InputError(s.str());
+  }
+  return a;
+}
+
+void check_region(const ParameterList& c, const ParameterList& regions,
+                  const Array<std::string>& faces);
+
+void check_dimension_arrays(ParameterList& input) {
+  ParameterList& d = input.sublist("Discretization");
+  const int dim = d.get<int>("Dimension");
+  const bool has_counts = !d.get<Array<int>>("Counts").empty();
+  const bool has_extents = !d.get<Array<double>>("Extents").empty();
+  if (has_counts == has_extents)
+    throw InputError("Error, " + d.name() +
+                     " needs exactly one of Counts (points per axis) and Extents (body size "
+                     "in m), each with " +
+                     std::to_string(dim) + " values.");
+  if (has_counts)
+    get_array<int>(d, "Counts", dim, "points per axis");
+  if (has_extents) {
+    const auto ext = get_array<double>(d, "Extents", dim, "body size per axis in m");
+    const double dx = d.get<double>("Spacing");
+    for (double e : ext) {
+      const double n = e / dx;
+      if (!(n >= 1) || std::abs(n - std::round(n)) > 1e-6 * n)
+        throw InputError("Error, " + path_of(d, "Extents") + " = " + std::to_string(e) +
+                         " is not a positive whole multiple of Spacing = " + std::to_string(dx) +
+                         ".");
+    }
+  }
+  if (!d.get<Array<double>>("Origin").empty())
+    get_array<double>(d, "Origin", dim, "m");
+  if (d.get<double>("Horizon") > 0 && d.isParameter("Horizon Factor") &&
+      !d.getEntry("Horizon Factor").isDefault())
+    throw InputError("Error, " + d.name() +
+                     " gives both Horizon and Horizon Factor: give one of the two.");
+  const Array<std::string> faces = d.get<Array<std::string>>("Boundary Layers");
+  for (const auto& f : faces)
+    if (f.size() == 2 && (f[1] - 'x') >= dim)
+      throw InputError("Error, " + path_of(d, "Boundary Layers") + " names face " + f +
+                       ", which a " + std::to_string(dim) + "D body does not have.");
+  ParameterList& regions = d.sublist("Regions");
+  int n_regions = 0;
+  for (auto it = regions.begin(); it != regions.end(); ++it, ++n_regions) {
+    ParameterList& r = regions.sublist(regions.name(it));
+    const auto lo = get_array<double>(r, "Min", dim, "lower corner in m");
+    const auto hi = get_array<double>(r, "Max", dim, "upper corner in m");
+    for (int k = 0; k < dim; ++k)
+      if (hi[k] < lo[k])
+        throw InputError("Error, " + r.name() + ": Max must not be below Min on any axis.");
+  }
+  if (n_regions + 2 * dim > 32)
+    throw InputError("Error, " + regions.name() + " holds " + std::to_string(n_regions) +
+                     " regions; at most " + std::to_string(32 - 2 * dim) + " are supported.");
+  ParameterList& cracks = d.sublist("Pre-Cracks");
+  for (auto it = cracks.begin(); it != cracks.end(); ++it) {
+    ParameterList& c = cracks.sublist(cracks.name(it));
+    if (dim == 2) {
+      get_array<double>(c, "Start", 2, "2D crack segment start in m");
+      get_array<double>(c, "End", 2, "2D crack segment end in m");
+      for (const char* k : {"Corner", "Edge 1", "Edge 2"})
+        if (!c.get<Array<double>>(k).empty())
+          throw InputError("Error, " + path_of(c, k) + " is for 3D cracks; use Start and End.");
+    } else {
+      get_array<double>(c, "Corner", 3, "3D crack rectangle corner in m");
+      const auto e1 = get_array<double>(c, "Edge 1", 3, "edge vector in m");
+      const auto e2 = get_array<double>(c, "Edge 2", 3, "edge vector in m");
+      const double dot = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
+      const double n1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+      const double n2 = std::sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+      if (n1 == 0 || n2 == 0 || std::abs(dot) > 1e-9 * n1 * n2)
+        throw InputError("Error, " + c.name() +
+                         ": Edge 1 and Edge 2 must be non-zero and orthogonal.");
+      for (const char* k : {"Start", "End"})
+        if (!c.get<Array<double>>(k).empty())
+          throw InputError("Error, " + path_of(c, k) +
+                           " is for 2D cracks; use Corner, Edge 1 and Edge 2.");
+    }
+  }
+  ParameterList& ics = input.sublist("Initial Conditions");
+  for (auto it = ics.begin(); it != ics.end(); ++it) {
+    ParameterList& c = ics.sublist(ics.name(it));
+    const std::string field = c.get<std::string>("Field");
+    get_array<double>(c, "Value", std::size_t(ic_components(field, dim)), field);
+    check_region(c, regions, faces);
+  }
+  ParameterList& bcs = input.sublist("Boundary Conditions");
+  for (auto it = bcs.begin(); it != bcs.end(); ++it) {
+    ParameterList& c = bcs.sublist(bcs.name(it));
+    check_region(c, regions, faces);
+    const auto type = boundary_condition_options()(c.get<std::string>("Type"));
+    const std::string comp = c.get<std::string>("Component");
+    const int axis = component_options()(comp);
+    const bool rotation =
+        type == BoundaryCondition::MicroRotation || type == BoundaryCondition::BodyCouple;
+    if (rotation && dim == 2 && axis != 2)
+      throw InputError("Error, " + path_of(c, "Component") + " = " + comp +
+                       ": in 2D the micro-rotation is about z; write z.");
+    if (!rotation && axis >= dim)
+      throw InputError("Error, " + path_of(c, "Component") + " = " + comp + ": a " +
+                       std::to_string(dim) + "D body has components x" +
+                       (dim == 3 ? ", y and z." : " and y."));
+    const auto tf = time_function_options()(c.get<std::string>("Time Function"));
+    if (tf == TimeFunction::Ramp && !(c.get<double>("Ramp Time") > 0))
+      throw InputError("Error, " + path_of(c, "Ramp Time") + " must be > 0 for a Ramp.");
+    if (tf == TimeFunction::Table) {
+      const auto t = c.get<Array<double>>("Times"), v = c.get<Array<double>>("Values");
+      bool increasing = t.size() >= 2;
+      for (Teuchos::Ordinal k = 1; k < t.size(); ++k)
+        increasing = increasing && t[k] > t[k - 1];
+      if (!increasing || v.size() != t.size())
+        throw InputError("Error, " + c.name() +
+                         ": a Table needs at least 2 increasing Times and as many Values.");
+    }
+  }
+  const ParameterList& solver = input.sublist("Solver");
+  if (!solver.get<Array<double>>("Gravity").empty())
+    get_array<double>(solver, "Gravity", dim, "m/s^2");
+  const std::string physics = solver.get<std::string>("Physics");
+  const Physics phys = physics_options()(physics);
+  const bool fluid = has_fluid(phys);
+  for (auto it = bcs.begin(); it != bcs.end(); ++it) {
+    const ParameterList& c = bcs.sublist(bcs.name(it));
+    const std::string type = c.get<std::string>("Type");
+    BoundaryCondition bc;
+    bc.kind = boundary_condition_options()(type);
+    if (!fluid && bc.fluid())
+      throw InputError("Error, " + path_of(c, "Type") + " = " + type +
+                       " needs Solver->Physics = Pore Fluid or Hydro-Mechanical (it is " + physics +
+                       ").");
+  }
+  if (fluid) {
+    const ParameterList& f = input.sublist("Fluid");
+    const double k = f.get<double>("Intrinsic Permeability"),
+                 kh = f.get<double>("Hydraulic Conductivity");
+    if ((k > 0) == (kh > 0))
+      throw InputError("Error, " + path_of(f, "Intrinsic Permeability") + " [m^2] or " +
+                       path_of(f, "Hydraulic Conductivity") + " [m/s]: give exactly one of them " +
+                       "> 0 for Solver->Physics = " + physics + " (" +
+                       (k > 0 ? "both are set" : "neither is set") + ").");
+    if (retention_model_options()(f.get<std::string>("Retention Model")) ==
+            RetentionModel::VanGenuchten &&
+        !(f.get<double>("Van Genuchten n") > 1))
+      throw InputError("Error, " + path_of(f, "Van Genuchten n") + " must be > 1.");
+    if (!(input.sublist("Materials").get<double>("Porosity") > 0))
+      throw InputError("Error, " + path_of(input.sublist("Materials"), "Porosity") +
+                       " must be > 0 for Solver->Physics = " + physics +
+                       " (the pores hold the water).");
+  }
+  if (has_solid(phys)) {
+    const ParameterList& m = input.sublist("Materials");
+    for (const char* k : {"Bulk Modulus", "Shear Modulus", "Length Scale"})
+      if (!(m.get<double>(k) > 0))
+        throw InputError("Error, " + path_of(m, k) +
+                         " must be > 0 for Solver->Physics = " + physics + ".");
+    const auto sm = stabilization_modulus_options()(m.get<std::string>("Stabilization Modulus"));
+    const double K = m.get<double>("Bulk Modulus"), mu = m.get<double>("Shear Modulus");
+    if (sm == StabilizationModulus::Eq71 && (dim == 2 || mu - (K - 2 * mu / 3) <= 0))
+      throw InputError("Error, " + path_of(m, "Stabilization Modulus") + " = Eq 71 " +
+                       (dim == 2 ? std::string("is a 3D formula")
+                                 : std::string("gives D <= 0 (Poisson's ratio >= 1/4)")) +
+                       ": use Automatic or Bulk Matching.");
+  }
+}
+
+void check_region(const ParameterList& c, const ParameterList& regions,
+                  const Array<std::string>& faces) {
+  const std::string region = c.get<std::string>("Region");
+  bool known = region == "All" || regions.isSublist(region);
+  for (const auto& f : faces)
+    known = known || region == "Layer " + f;
+  if (!known)
+    throw InputError("Error, " + path_of(c, "Region") + " = '" + region +
+                     "' names no region; expected All, a sublist of " + regions.name() +
+                     " or a boundary layer such as 'Layer -y'.");
+}
+
+// Teuchos reads numbers with operator>>, which turns "abc" or "1e-3x" in an Array(double) into
+// 0 without a word. Check every numeric value's text strictly before Teuchos converts it.
+bool strict_number(const std::string& token, bool integer) {
+  std::size_t b = token.find_first_not_of(" \t\n"), e = token.find_last_not_of(" \t\n");
+  if (b == std::string::npos)
+    return false;
+  const std::string t = token.substr(b, e - b + 1);
+  char* end = nullptr;
+  errno = 0;
+  if (integer) {
+    const long long v = std::strtoll(t.c_str(), &end, 10);
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+      return false;
+  } else {
+    const double v = std::strtod(t.c_str(), &end);
+    if (!std::isfinite(v))
+      return false;
+  }
+  return errno == 0 && end == t.c_str() + t.size();
+}
+
+void check_numbers(const Teuchos::XMLObject& node, const std::string& path) {
+  for (int k = 0; k < node.numChildren(); ++k) {
+    const Teuchos::XMLObject& c = node.getChild(k);
+    if (!c.hasAttribute("name"))
+      continue;
+    const std::string name = c.getAttribute("name");
+    if (c.getTag() == "ParameterList") {
+      check_numbers(c, path + "->" + name);
+      continue;
+    }
+    if (c.getTag() != "Parameter" || !c.hasAttribute("type") || !c.hasAttribute("value"))
+      continue;
+    const std::string type = c.getAttribute("type"), value = c.getAttribute("value");
+    const bool is_int = type == "int" || type == "Array(int)";
+    const bool is_double = type == "double" || type == "Array(double)";
+    if (!is_int && !is_double)
+      continue;
+    std::vector<std::string> tokens;
+    if (type.rfind("Array", 0) == 0) {
+      std::size_t b = value.find('{'), e = value.rfind('}');
+      if (b == std::string::npos || e == std::string::npos || e < b)
+        throw InputError("Error, " + path + "->" + name + " = \"" + value +
+                         "\" is not an array: write {a, b, ...}.");
+      const std::string inner = value.substr(b + 1, e - b - 1);
+      if (inner.find_first_not_of(" \t\n") != std::string::npos) {
+        std::stringstream ss(inner);
+        for (std::string tok; std::getline(ss, tok, ',');)
+          tokens.push_back(tok);
+      }
+    } else {
+      tokens.push_back(value);
+    }
+    for (const auto& tok : tokens)
+      if (!strict_number(tok, is_int))
+        throw InputError("Error, " + path + "->" + name + " = \"" + value + "\": \"" + tok +
+                         "\" is not a finite " + (is_int ? "int" : "double") + " number.");
+  }
+}
+
+}  // namespace
+
+RCP<ParameterList> parse_input(const std::string& xml) {
+  try {
+    check_numbers(Teuchos::StringInputSource(xml).getObject(), "mupm");
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception&) {
+    // Malformed XML: reported below by the parameter-list reader with its line number.
+  }
+  try {
+    auto pl = Teuchos::getParametersFromXmlString(xml);
+    name_lists(*pl, "mupm");
+    return pl;
+  } catch (const std::exception& e) {
+    // Keep the parser's own sentence ("XML parse error at line N: ..."), not its source location.
+    std::string msg = e.what();
+    const auto pos = msg.find("XML parse error");
+    if (pos != std::string::npos)
+      msg = msg.substr(pos);
+    throw InputError("Error, the input is not a valid Teuchos XML parameter list: " + msg);
+  }
+}
+
+RCP<ParameterList> read_input(const Teuchos::Comm<int>& comm, const std::string& path) {
+  std::string text;
+  int ok = 1;
+  if (comm.getRank() == 0) {
+    std::ifstream f(path);
+    if (!f) {
+      ok = 0;
+    } else {
+      std::ostringstream s;
+      s << f.rdbuf();
+      text = s.str();
+    }
+  }
+  Teuchos::broadcast(comm, 0, &ok);
+  if (!ok)
+    throw InputError("Error, cannot read the input file '" + path + "'.");
+  long long n = static_cast<long long>(text.size());
+  Teuchos::broadcast(comm, 0, &n);
+  text.resize(static_cast<std::size_t>(n));
+  if (n > 0)
+    Teuchos::broadcast(comm, 0, static_cast<int>(n), &text[0]);
+  return parse_input(text);
+}
+
+void validate_input(ParameterList& input) {
+  if (input.isSublist("Discretization") && !input.sublist("Discretization").isParameter("Spacing"))
+    throw InputError("Error, the required parameter " + input.name() +
+                     "->Discretization->Spacing (point spacing in m, a double > 0) is missing.");
+  if (!input.isSublist("Discretization"))
+    throw InputError("Error, the required sublist " + input.name() +
+                     "->Discretization is missing.");
+  validate_level(input, *valid_parameters());
+  check_dimension_arrays(input);
+}
+
+int input_dimension(const ParameterList& input) {
+  return input.sublist("Discretization").get<int>("Dimension");
+}
+
+template <int Dim>
+GridSpec<Dim> grid_from_input(const ParameterList& input) {
+  const ParameterList& d = input.sublist("Discretization");
+  GridSpec<Dim> g;
+  g.dx = d.get<double>("Spacing");
+  const double h = d.get<double>("Horizon");
+  g.horizon = h > 0 ? h : d.get<double>("Horizon Factor") * g.dx;
+  g.thickness = Dim == 2 ? d.get<double>("Thickness") : 1.0;
+  const auto counts = d.get<Array<int>>("Counts");
+  const auto ext = d.get<Array<double>>("Extents");
+  const auto origin = d.get<Array<double>>("Origin");
+  for (int k = 0; k < Dim; ++k) {
+    g.counts[k] = counts.empty() ? std::llround(ext[k] / g.dx) : counts[k];
+    g.origin[k] = origin.empty() ? 0.0 : origin[k];
+  }
+  const int rows =
+      static_cast<int>(d.get<double>("Boundary Layer Horizons") * g.horizon / g.dx * (1 + 1e-10));
+  for (const auto& f : d.get<Array<std::string>>("Boundary Layers"))
+    g.layers[f[1] - 'x'][f[0] == '-' ? 0 : 1] = rows;
+  const ParameterList& regions = d.sublist("Regions");
+  for (auto it = regions.begin(); it != regions.end(); ++it) {
+    const ParameterList& r = regions.sublist(regions.name(it));
+    Box b;
+    const auto lo = r.get<Array<double>>("Min"), hi = r.get<Array<double>>("Max");
+    for (int k = 0; k < Dim; ++k) {
+      b.lo[k] = lo[k];
+      b.hi[k] = hi[k];
+    }
+    g.region_names.push_back(regions.name(it));
+    g.regions.push_back(b);
+  }
+  // Boundary layers as regions: the rows outside the face, across the whole lattice.
+  for (int k = 0; k < Dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      if (g.layers[k][side] == 0)
+        continue;
+      Box b;
+      for (int j = 0; j < Dim; ++j) {
+        b.lo[j] = g.origin[j] - (g.layers[j][0] + 1) * g.dx;
+        b.hi[j] = g.origin[j] + (g.counts[j] + g.layers[j][1] + 1) * g.dx;
+      }
+      const double lo_face = g.origin[k], hi_face = g.origin[k] + g.counts[k] * g.dx;
+      if (side == 0)
+        b.hi[k] = lo_face - 0.25 * g.dx;
+      else
+        b.lo[k] = hi_face + 0.25 * g.dx;
+      g.region_names.push_back(std::string("Layer ") + (side ? '+' : '-') + char('x' + k));
+      g.regions.push_back(b);
+    }
+  const ParameterList& cracks = d.sublist("Pre-Cracks");
+  for (auto it = cracks.begin(); it != cracks.end(); ++it) {
+    const ParameterList& c = cracks.sublist(cracks.name(it));
+    Crack cr;
+    if (Dim == 2) {
+      const auto a = c.get<Array<double>>("Start"), b = c.get<Array<double>>("End");
+      for (int k = 0; k < 2; ++k) {
+        cr.a[k] = a[k];
+        cr.b[k] = b[k];
+      }
+    } else {
+      const auto a = c.get<Array<double>>("Corner"), e1 = c.get<Array<double>>("Edge 1"),
+                 e2 = c.get<Array<double>>("Edge 2");
+      for (int k = 0; k < 3; ++k) {
+        cr.a[k] = a[k];
+        cr.b[k] = e1[k];
+        cr.c[k] = e2[k];
+      }
+    }
+    g.cracks.push_back(cr);
+  }
+  return g;
+}
+
+template GridSpec<2> grid_from_input<2>(const ParameterList&);
+template GridSpec<3> grid_from_input<3>(const ParameterList&);
+
+namespace {
+
+// Region names in bit order: the user's regions, then the boundary layers (as grid_from_input).
+std::vector<std::string> region_names(const ParameterList& input) {
+  const ParameterList& d = input.sublist("Discretization");
+  std::vector<std::string> names;
+  const ParameterList& regions = d.sublist("Regions");
+  for (auto it = regions.begin(); it != regions.end(); ++it)
+    names.push_back(regions.name(it));
+  const int dim = d.get<int>("Dimension");
+  const auto faces = d.get<Array<std::string>>("Boundary Layers");
+  for (int k = 0; k < dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      const std::string f = std::string(side ? "+" : "-") + char('x' + k);
+      for (const auto& g : faces)
+        if (g == f) {
+          names.push_back("Layer " + f);
+          break;
+        }
+    }
+  return names;
+}
+
+std::uint32_t region_mask(const std::vector<std::string>& names, const std::string& region) {
+  for (std::size_t r = 0; r < names.size(); ++r)
+    if (names[r] == region)
+      return 1u << r;
+  return 0;  // All
+}
+
+}  // namespace
+
+std::vector<InitialCondition> initial_conditions_from_input(const ParameterList& input) {
+  const auto names = region_names(input);
+  std::vector<InitialCondition> out;
+  const ParameterList& ics = input.sublist("Initial Conditions");
+  for (auto it = ics.begin(); it != ics.end(); ++it) {
+    const ParameterList& c = ics.sublist(ics.name(it));
+    InitialCondition ic;
+    ic.name = ics.name(it);
+    ic.field = c.get<std::string>("Field");
+    ic.region_mask = region_mask(names, c.get<std::string>("Region"));
+    const auto v = c.get<Array<double>>("Value");
+    ic.value.assign(v.begin(), v.end());
+    out.push_back(ic);
+  }
+  return out;
+}
+
+std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterList& input) {
+  const auto names = region_names(input);
+  const int dim = input_dimension(input);
+  std::vector<BoundaryCondition> out;
+  const ParameterList& bcs = input.sublist("Boundary Conditions");
+  for (auto it = bcs.begin(); it != bcs.end(); ++it) {
+    const ParameterList& c = bcs.sublist(bcs.name(it));
+    BoundaryCondition bc;
+    bc.name = bcs.name(it);
+    bc.kind = boundary_condition_options()(c.get<std::string>("Type"));
+    bc.region_mask = region_mask(names, c.get<std::string>("Region"));
+    bc.component = component_options()(c.get<std::string>("Component"));
+    // In 2D the only rotation component, about z, is theta's component 0.
+    if ((bc.kind == BoundaryCondition::MicroRotation || bc.kind == BoundaryCondition::BodyCouple) &&
+        dim == 2)
+      bc.component = 0;
+    bc.value = c.get<double>("Value");
+    bc.time.kind = time_function_options()(c.get<std::string>("Time Function"));
+    bc.time.ramp_time = c.get<double>("Ramp Time");
+    const auto t = c.get<Array<double>>("Times"), v = c.get<Array<double>>("Values");
+    bc.time.times.assign(t.begin(), t.end());
+    bc.time.values.assign(v.begin(), v.end());
+    out.push_back(bc);
+  }
+  return out;
+}
+
+}  // namespace mupm

@@ -1,0 +1,141 @@
+#include "mupm/input/model.hpp"
+
+#include <Teuchos_Array.hpp>
+
+namespace mupm {
+
+using Teuchos::Array;
+using Teuchos::ParameterList;
+
+const Options<Physics>& physics_options() {
+  static const Options<Physics> o("Physics", {{"Micropolar Solid", Physics::MicropolarSolid},
+                                              {"Kinematics Only", Physics::KinematicsOnly},
+                                              {"Pore Fluid", Physics::PoreFluid},
+                                              {"Hydro-Mechanical", Physics::HydroMechanical}});
+  return o;
+}
+const Options<Staggering>& staggering_options() {
+  static const Options<Staggering> o("Staggering", {{"Solid First", Staggering::SolidFirst},
+                                                    {"Fluid First", Staggering::FluidFirst}});
+  return o;
+}
+const Options<ConstitutiveModel>& constitutive_model_options() {
+  static const Options<ConstitutiveModel> o(
+      "Model", {{"Micropolar Elastic", ConstitutiveModel::MicropolarElastic}});
+  return o;
+}
+const Options<StabilizationModulus>& stabilization_modulus_options() {
+  static const Options<StabilizationModulus> o(
+      "Stabilization Modulus", {{"Automatic", StabilizationModulus::Automatic},
+                                {"Eq 71", StabilizationModulus::Eq71},
+                                {"Bulk Matching", StabilizationModulus::BulkMatching}});
+  return o;
+}
+const Options<RetentionModel>& retention_model_options() {
+  static const Options<RetentionModel> o(
+      "Retention Model",
+      {{"Saturated", RetentionModel::Saturated}, {"Van Genuchten", RetentionModel::VanGenuchten}});
+  return o;
+}
+const Options<BoundaryCondition::Kind>& boundary_condition_options() {
+  static const Options<BoundaryCondition::Kind> o(
+      "Type", {{"Displacement", BoundaryCondition::Displacement},
+               {"Velocity", BoundaryCondition::Velocity},
+               {"Micro-Rotation", BoundaryCondition::MicroRotation},
+               {"Traction", BoundaryCondition::Traction},
+               {"Body Force", BoundaryCondition::BodyForce},
+               {"Body Couple", BoundaryCondition::BodyCouple},
+               {"Pore Pressure", BoundaryCondition::PorePressure},
+               {"Fluid Source", BoundaryCondition::FluidSource}});
+  return o;
+}
+const Options<TimeFunction::Kind>& time_function_options() {
+  static const Options<TimeFunction::Kind> o("Time Function", {{"Constant", TimeFunction::Constant},
+                                                               {"Ramp", TimeFunction::Ramp},
+                                                               {"Rate", TimeFunction::Rate},
+                                                               {"Table", TimeFunction::Table}});
+  return o;
+}
+const Options<int>& component_options() {
+  static const Options<int> o("Component", {{"x", 0}, {"y", 1}, {"z", 2}});
+  return o;
+}
+
+template <int Dim>
+Model<Dim> model_from_input(const ParameterList& input) {
+  Model<Dim> m;
+  m.grid = grid_from_input<Dim>(input);
+  const ParameterList& solver = input.sublist("Solver");
+  const ParameterList& output = input.sublist("Output");
+  const ParameterList& diag = input.sublist("Diagnostics");
+  const ParameterList& materials = input.sublist("Materials");
+  const ParameterList& fluid = input.sublist("Fluid");
+
+  RunSettings& r = m.run;
+  r.physics = physics_options()(solver.get<std::string>("Physics"));
+  r.staggering = staggering_options()(solver.get<std::string>("Staggering"));
+  r.solid_steps_per_fluid_step = solver.get<int>("Solid Steps Per Fluid Step");
+  r.fluid_substeps = solver.get<int>("Fluid Substeps");
+  r.time_step = solver.get<double>("Time Step");
+  r.automatic_time_step = solver.get<bool>("Automatic Time Step");
+  r.safety = solver.get<double>("Time Step Safety Factor");
+  r.n_steps = solver.get<int>("Number of Steps");
+  r.energy_tolerance = solver.get<double>("Energy Tolerance");
+  r.stop_on_energy_violation = solver.get<bool>("Stop On Energy Violation");
+  r.energy_check_start = solver.get<int>("Energy Check Start");
+  r.restart_from = solver.get<std::string>("Restart From");
+  r.folder = output.get<std::string>("Folder");
+  const auto fields = output.get<Array<std::string>>("Fields");
+  r.fields.assign(fields.begin(), fields.end());
+  r.field_interval = output.get<int>("Field Interval");
+  r.series_interval = output.get<int>("Time Series Interval");
+  r.checkpoint_interval = output.get<int>("Checkpoint Interval");
+  r.checkpoint_at_end = output.get<bool>("Checkpoint At End");
+  r.progress_interval = output.get<double>("Progress Interval");
+  r.kernel_timers = diag.get<bool>("Kernel Timers");
+  r.check_finite = diag.get<bool>("Check Finite");
+
+  const auto g = solver.get<Array<double>>("Gravity");
+  for (Teuchos::Ordinal k = 0; k < g.size() && k < 3; ++k)
+    m.gravity[k] = g[k];
+  m.damping = solver.get<double>("Damping");
+
+  m.constitutive_model = constitutive_model_options()(materials.get<std::string>("Model"));
+  m.solid = solid_params<Dim>(
+      MicropolarElastic::from_bulk_shear(
+          materials.get<double>("Bulk Modulus"), materials.get<double>("Shear Modulus"),
+          materials.get<double>("Micropolar Shear Modulus"), materials.get<double>("Length Scale")),
+      m.grid, materials.get<double>("Stabilization"),
+      stabilization_modulus_options()(materials.get<std::string>("Stabilization Modulus")));
+  m.solid_density = materials.get<double>("Solid Density");
+  m.porosity = materials.get<double>("Porosity");
+
+  const double rho_w = fluid.get<double>("Water Density");
+  const double k = fluid.get<double>("Intrinsic Permeability");
+  m.fluid = fluid_params<Dim>(
+      m.grid,
+      k > 0 ? k / fluid.get<double>("Viscosity")
+            : fluid.get<double>("Hydraulic Conductivity") / (rho_w * kStandardGravity),
+      fluid.get<double>("Flow Stabilization"));
+  m.fluid.water_density = rho_w;
+  m.fluid.bulk_modulus = fluid.get<double>("Fluid Bulk Modulus");
+  if (retention_model_options()(fluid.get<std::string>("Retention Model")) ==
+      RetentionModel::VanGenuchten) {
+    m.fluid.retention = VanGenuchten::mualem(fluid.get<double>("Air Entry Pressure"),
+                                             fluid.get<double>("Van Genuchten n"));
+    const double vm = fluid.get<double>("Van Genuchten m");
+    if (vm > 0)
+      m.fluid.retention.m = vm;
+  }
+  if (fluid.get<bool>("Gravity In Darcy Flux"))
+    m.fluid.gravity = m.gravity;
+
+  m.boundary_conditions = boundary_conditions_from_input(input);
+  m.initial_conditions = initial_conditions_from_input(input);
+  return m;
+}
+
+template Model<2> model_from_input<2>(const ParameterList&);
+template Model<3> model_from_input<3>(const ParameterList&);
+
+}  // namespace mupm

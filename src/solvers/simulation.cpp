@@ -1,0 +1,450 @@
+#include "mupm/solvers/simulation.hpp"
+
+#include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_XMLParameterListCoreHelpers.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "mupm/core/timers.hpp"
+#include "mupm/input/model.hpp"
+#include "mupm/io/checkpoint.hpp"
+#include "mupm/io/csv.hpp"
+#include "mupm/io/field_output.hpp"
+#include "mupm/io/point_rows.hpp"
+#include "mupm/solvers/kinematics.hpp"
+#include "mupm/solvers/solid_solver.hpp"
+#include "mupm/solvers/step_sequence.hpp"
+
+namespace mupm {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A stable-step estimate rounded down to 3 significant digits: the power iteration's sums over
+// ranks differ in the last bits between rank counts, and an automatic step must not, or runs
+// on different rank counts (and restarts) would diverge at round-off.
+double three_digits(double x) {
+  if (!(x > 0))
+    return x;
+  const double scale = std::pow(10.0, std::floor(std::log10(x)) - 2);
+  return std::floor(x / scale * (1 + 1e-12)) * scale;
+}
+
+std::string format_seconds(double s) {
+  char buf[64];
+  if (s < 120)
+    std::snprintf(buf, sizeof buf, "%.1f s", s);
+  else if (s < 7200)
+    std::snprintf(buf, sizeof buf, "%.1f min", s / 60);
+  else
+    std::snprintf(buf, sizeof buf, "%.2f h", s / 3600);
+  return buf;
+}
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// Creates the output folder and writes the resolved input there, before the heavy work, so a
+// bad folder fails early.
+void prepare_folder(const Teuchos::Comm<int>& comm, const std::string& folder,
+                    const Teuchos::ParameterList& input) {
+  int ok = 1;
+  std::string why;
+  if (comm.getRank() == 0) {
+    std::error_code ec;
+    std::filesystem::create_directories(folder, ec);
+    if (ec) {
+      ok = 0;
+      why = ec.message();
+    } else {
+      try {
+        Teuchos::writeParameterListToXmlFile(input, folder + "/input_resolved.xml");
+      } catch (const std::exception& e) {
+        ok = 0;
+        why = e.what();
+      }
+    }
+  }
+  Teuchos::broadcast(comm, 0, &ok);
+  if (!ok)
+    throw CollectiveError("Error, cannot write to the output folder '" + folder +
+                          "' (Output->Folder)" + (why.empty() ? "" : ": " + why));
+}
+
+// The largest global id of an owned point whose registry fields marked kFinite (the primary
+// state: u, v, a, theta and its rates, p, p_f; every other field derives from them) hold a NaN
+// or Inf, or -1. One pass.
+template <int Dim>
+GlobalId non_finite_point(const Points<Dim>& p) {
+  constexpr int kMax = 16;
+  Kokkos::Array<Vectors, kMax> f;
+  int nf = 0;
+  for (const auto& v : p.double_fields(kFinite))
+    if (nf < kMax)
+      f[nf++] = v;
+  auto gid = p.gid;
+  GlobalId g = -1;
+  Kokkos::parallel_reduce(
+      "mupm::Diagnostics::finite", range(0, p.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i, GlobalId& m) {
+        bool ok = true;
+        for (int k = 0; k < nf; ++k)
+          for (std::size_t c = 0; c < f[k].extent(1); ++c)
+            ok = ok && std::isfinite(f[k](i, c));
+        if (!ok && gid(i) > m)
+          m = gid(i);
+      },
+      Kokkos::Max<GlobalId>(g));
+  return g;
+}
+
+// The physics modules of a run and the step sequence over them (Algorithm 1).
+template <int Dim>
+struct Assembly {
+  std::unique_ptr<FluidSolver<Dim>> fluid;
+  std::unique_ptr<Mechanics> mechanics;  // the micropolar solid, kinematics, or none
+  std::unique_ptr<Damage<Dim>> damage;
+  StepSequence<Dim> sequence;
+  // Time series, restart globals and energy balances, in the time series' column order.
+  std::vector<Module*> modules() const {
+    std::vector<Module*> m{damage.get()};
+    if (mechanics)
+      m.push_back(mechanics.get());
+    if (fluid)
+      m.push_back(fluid.get());
+    return m;
+  }
+  NamedGlobals globals() const {
+    NamedGlobals out;
+    for (Module* m : modules()) {
+      GlobalRefs g;
+      m->globals(g);
+      for (const auto& [name, ptr] : g.refs())
+        out.push_back({std::string(m->name()) + "/" + name, ptr});
+    }
+    return out;
+  }
+};
+
+template <int Dim>
+Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_Comm mpi) {
+  Assembly<Dim> ph;
+  const Physics physics = model.run.physics;
+  if (has_fluid(physics))
+    ph.fluid =
+        std::make_unique<FluidSolver<Dim>>(disc, model.fluid, model.boundary_conditions, mpi);
+  if (has_solid(physics)) {
+    typename SolidSolver<Dim>::Settings settings;
+    settings.rho_s = model.solid_density;
+    settings.rho_w = model.fluid.water_density;
+    settings.gravity = model.gravity;
+    settings.damping = model.damping;
+    switch (model.constitutive_model) {
+      case ConstitutiveModel::MicropolarElastic:
+        ph.mechanics = std::make_unique<SolidSolver<Dim, MicropolarElastic>>(
+            disc, model.solid, model.boundary_conditions, settings, mpi);
+        break;
+    }
+  } else if (physics == Physics::KinematicsOnly) {
+    ph.mechanics = std::make_unique<Kinematics<Dim>>(disc);
+  }
+  ph.damage = std::make_unique<Damage<Dim>>(disc, mpi);
+  ph.sequence.mechanics = ph.mechanics.get();
+  ph.sequence.fluid = ph.fluid.get();
+  ph.sequence.damage = ph.damage.get();
+  ph.sequence.fluid_first = model.run.staggering == Staggering::FluidFirst;
+  ph.sequence.fluid_every = ph.mechanics ? model.run.solid_steps_per_fluid_step : 1;
+  return ph;
+}
+
+// The time step and the fluid's substeps from the modules' stable-step estimates (Automatic
+// Time Step, Fluid Substeps = 0), with warnings where the given ones exceed them.
+template <int Dim>
+double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, int rank, std::ostream& out) {
+  const double safety = run.safety;
+  double dt = run.time_step;
+  auto* solid = dynamic_cast<SolidSolver<Dim>*>(ph.mechanics.get());
+  if (solid) {
+    const double stiffening = ph.fluid ? ph.fluid->undrained_stiffening() : 0.0;
+    const double stable = three_digits(solid->stable_time_step());
+    if (run.automatic_time_step)
+      dt = safety * stable;
+    if (rank == 0) {
+      out << "mupm: micropolar solid, stabilization G = " << solid->params().stabilization
+          << ", D = " << solid->params().stab_modulus << " Pa/m^2; estimated stable dt = " << stable
+          << " s" << (ph.fluid ? " (undrained: the pore water adds up to " : "");
+      if (ph.fluid)
+        out << stiffening << " Pa to the bulk modulus)";
+      out << "; dt = " << dt << " s\n";
+      if (dt > safety * stable)
+        out << "mupm: WARNING: Solver->Time Step = " << dt << " s exceeds "
+            << "Time Step Safety Factor x the estimated stable step = " << safety * stable
+            << " s: the run may blow up. Use a smaller Time Step or Automatic Time Step.\n";
+    }
+  }
+  if (ph.fluid) {
+    auto& fluid = *ph.fluid;
+    const double stable_f = three_digits(fluid.estimate_stable_dt());
+    if (!solid && run.automatic_time_step)
+      dt = safety * stable_f;
+    const int every = ph.sequence.fluid_every;
+    const double interval = every * dt;
+    int substeps = run.fluid_substeps;
+    if (substeps == 0)
+      substeps = std::max(1, int(std::ceil(interval / (safety * stable_f) - 1e-9)));
+    ph.sequence.substeps = substeps;
+    const double dt_f = interval / substeps;
+    if (rank == 0) {
+      out << "mupm: pore fluid, k/mu_w = " << fluid.params().mobility
+          << " m^2/(Pa s), K_w = " << fluid.params().bulk_modulus
+          << " Pa, flow stabilization G = " << fluid.params().stabilization
+          << "; estimated stable fluid dt = " << stable_f << " s; fluid dt = " << dt_f << " s ("
+          << substeps << " substep(s) every " << every << " step(s), "
+          << (solid ? (ph.sequence.fluid_first ? "fluid first" : "solid first") : "fluid only")
+          << ")\n";
+      if (dt_f > safety * stable_f)
+        out << "mupm: WARNING: the fluid step " << dt_f << " s exceeds Time Step Safety Factor x "
+            << "the estimated stable fluid step = " << safety * stable_f
+            << " s: the pressure may blow up. Raise Solver->Fluid Substeps (0: automatic).\n";
+    }
+  }
+  return dt;
+}
+
+// After each step: the energy balances (eqs 140 and 149) against the tolerance, and the
+// primary fields for NaN/Inf. Throws CollectiveError to stop the run.
+template <int Dim>
+class StepChecks {
+ public:
+  StepChecks(const RunSettings& run, const Discretization<Dim>& disc, MPI_Comm mpi, int rank,
+             std::ostream& out)
+      : run_(run), disc_(disc), mpi_(mpi), rank_(rank), out_(out) {}
+
+  void operator()(const std::vector<Module*>& modules, long long steps_done, long long step,
+                  double time) {
+    for (Module* m : modules)
+      for (const auto& b : m->energy_balances())
+        energy(b, steps_done, step, time);
+    if (run_.check_finite)
+      finite(step, time);
+  }
+
+ private:
+  void energy(const EnergyBalance& b, long long steps_done, long long step, double time) {
+    if (steps_done <= run_.energy_check_start ||
+        !(b.error > run_.energy_tolerance * b.scale && b.scale > 0))
+      return;
+    std::ostringstream s;
+    s << b.what << " energy balance violated at step " << step << " (t = " << time << " s): |"
+      << b.expression << "| = " << b.error << " J is " << b.error / b.scale
+      << " of the largest term (Solver->Energy Tolerance = " << run_.energy_tolerance << ")";
+    if (run_.stop_on_energy_violation)
+      throw CollectiveError("Error, " + s.str() + ".");
+    long long& warnings = warnings_[b.what];
+    if (rank_ == 0 && (warnings < 5 || warnings % 1000 == 0))
+      out_ << "mupm: WARNING: " << s.str() << "\n";
+    ++warnings;
+  }
+
+  void finite(long long step, double time) {
+    const auto& pts = disc_.points;
+    GlobalId bad = non_finite_point(pts);
+    MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_LONG_LONG, MPI_MAX, mpi_);
+    if (bad < 0)
+      return;
+    // The owner supplies the position; the sum over ranks hands it to everyone.
+    double where[3] = {0, 0, 0};
+    auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.gid);
+    auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
+    for (std::size_t i = 0; i < pts.n_owned; ++i)
+      if (gid(i) == bad)
+        for (int k = 0; k < Dim; ++k)
+          where[k] = x(i, k);
+    MPI_Allreduce(MPI_IN_PLACE, where, 3, MPI_DOUBLE, MPI_SUM, mpi_);
+    std::ostringstream s;
+    s << "Error, a field is NaN or Inf at step " << step << " (t = " << time
+      << " s), at the point with global id " << bad << ", reference position (" << where[0] << ", "
+      << where[1] << (Dim == 3 ? ", " + std::to_string(where[2]) : std::string()) << ") m.";
+    throw CollectiveError(s.str());
+  }
+
+  const RunSettings& run_;
+  const Discretization<Dim>& disc_;
+  MPI_Comm mpi_;
+  int rank_;
+  std::ostream& out_;
+  std::map<std::string, long long> warnings_;
+};
+
+// The largest displacement magnitude over all points.
+template <int Dim>
+double max_displacement(const Points<Dim>& pts, MPI_Comm mpi) {
+  auto u = pts.u;
+  double umax2 = 0;
+  Kokkos::parallel_reduce(
+      "mupm::Diagnostics::max_displacement", range(0, pts.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i, double& m) {
+        double s = 0;
+        for (int k = 0; k < Dim; ++k)
+          s += u(i, k) * u(i, k);
+        m = s > m ? s : m;
+      },
+      Kokkos::Max<double>(umax2));
+  MPI_Allreduce(MPI_IN_PLACE, &umax2, 1, MPI_DOUBLE, MPI_MAX, mpi);
+  return std::sqrt(umax2);
+}
+
+template <int Dim>
+RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::ParameterList& input,
+               std::ostream& out) {
+  // ---------------------------------------------------------------- set-up
+  const auto t_start = Clock::now();
+  const MPI_Comm mpi = io::raw(*comm);
+  const int rank = comm->getRank();
+  const Model<Dim> model = model_from_input<Dim>(input);
+  const RunSettings& run = model.run;
+  const bool timers_on = run.kernel_timers && timers::enable();
+  prepare_folder(*comm, run.folder, input);
+
+  Discretization<Dim> disc = discretize(comm, model.grid);
+  Points<Dim>& pts = disc.points;
+  long long counts[2] = {static_cast<long long>(disc.bonds.size()),
+                         static_cast<long long>(pts.n_ghost)};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_LONG_LONG, MPI_SUM, mpi);
+  const long long n_bonds = counts[0], n_global = disc.dist.n_global();
+  if (rank == 0)
+    out << "mupm: " << Dim << "D, " << n_global << " points (" << counts[1] << " ghost copies), "
+        << n_bonds << " bonds, dx = " << model.grid.dx << " m, horizon = " << model.grid.horizon
+        << " m (" << model.grid.horizon / model.grid.dx << " dx)\n"
+        << "mupm: " << comm->getSize() << " rank(s) x " << ExecSpace().concurrency() << " "
+        << ExecSpace::name() << " thread(s); " << Points<Dim>::bytes_per_point()
+        << " bytes per point, " << Bonds::bytes_per_bond() << " bytes per bond\n";
+
+  // Initial state (saturated unless an initial condition says otherwise), or the checkpoint's.
+  Kokkos::deep_copy(pts.porosity, model.porosity);
+  Kokkos::deep_copy(pts.saturation, 1.0);
+  Kokkos::Array<double, 3> rho_w_g{};
+  for (int k = 0; k < 3; ++k)
+    rho_w_g[k] = model.fluid.water_density * model.gravity[k];
+  apply_initial_conditions(model.initial_conditions, pts, rho_w_g);
+  Assembly<Dim> ph = assemble(model, disc, mpi);
+  long long step = 0;
+  double time = 0;
+  std::vector<double> history;
+  const bool restarted = !run.restart_from.empty();
+  if (restarted) {
+    read_checkpoint(run.restart_from, disc, step, time, history, ph.globals());
+    if (rank == 0)
+      out << "mupm: restarted from " << run.restart_from << " at step " << step << "\n";
+  }
+  ph.damage->update();
+  disc.dist.refresh(pts.double_fields(kGhosted));
+  if (ph.fluid)
+    ph.fluid->initialize(time, restarted);
+  if (auto* solid = dynamic_cast<SolidSolver<Dim>*>(ph.mechanics.get())) {
+    solid->initialize(time, restarted);
+    if (ph.fluid && !restarted)
+      ph.fluid->reset_strain_reference();
+  }
+  const double dt = choose_time_step(run, ph, rank, out);
+
+  FieldOutput<Dim> fields(run.folder, disc, run.fields, history);
+  std::unique_ptr<io::CsvWriter> csv;
+  auto write_series = [&] {
+    ScopedRegion region("mupm::Output::time_series");
+    SeriesRow row;
+    row("step", double(step));
+    row("time", time);
+    row("max_displacement", max_displacement(pts, mpi));
+    for (Module* m : ph.modules())
+      m->series(row);
+    row("wall_seconds", seconds_since(t_start));
+    if (rank == 0 && !csv)
+      csv =
+          std::make_unique<io::CsvWriter>(run.folder + "/time_series.csv", row.names(), restarted);
+    if (csv)
+      csv->row(row.values());
+  };
+  const std::string checkpoint_path = run.folder + "/checkpoint.h5";
+  auto checkpoint = [&] {
+    write_checkpoint(checkpoint_path, disc, step, time, fields.history(), ph.globals());
+  };
+  if (!restarted) {
+    fields.write(step, time);
+    write_series();
+  }
+
+  // ---------------------------------------------------------------- loop
+  const long long first_step = step, last_step = run.n_steps;
+  StepChecks<Dim> checks(run, disc, mpi, rank, out);
+  const auto t_loop = Clock::now();
+  auto t_last_progress = t_loop;
+  while (step < last_step) {
+    {
+      ScopedRegion region("mupm::Solver::step");
+      ph.sequence.step(step, time, dt);
+    }
+    ++step;
+    time += dt;
+    checks(ph.modules(), step - first_step, step, time);
+    if (step % run.series_interval == 0 || step == last_step)
+      write_series();
+    if ((run.field_interval > 0 && step % run.field_interval == 0) || step == last_step)
+      fields.write(step, time);
+    if (run.checkpoint_interval > 0 && step % run.checkpoint_interval == 0 && step != last_step)
+      checkpoint();
+    if (rank == 0 &&
+        (seconds_since(t_last_progress) >= run.progress_interval || step == last_step)) {
+      t_last_progress = Clock::now();
+      const double el = seconds_since(t_loop);
+      const double done = double(step - first_step), left = double(last_step - step);
+      char line[256];
+      std::snprintf(line, sizeof line,
+                    "step %lld/%lld (%.1f%%)  t = %.6g s  elapsed %s  ETA %s  %.3g point-steps/s\n",
+                    step, last_step, 100.0 * double(step) / double(last_step), time,
+                    format_seconds(el).c_str(),
+                    format_seconds(done > 0 ? el / done * left : 0).c_str(),
+                    el > 0 ? double(n_global) * done / el : 0.0);
+      out << line << std::flush;
+    }
+  }
+
+  // ---------------------------------------------------------------- finish
+  if (run.checkpoint_at_end)
+    checkpoint();
+  RunSummary summary;
+  summary.steps = step - first_step;
+  summary.wall_seconds = seconds_since(t_loop);
+  summary.n_points = n_global;
+  summary.n_bonds = n_bonds;
+  if (timers_on) {
+    timers::report(mpi, out);
+    timers::disable();
+  }
+  if (rank == 0 && summary.steps > 0 && summary.wall_seconds > 0) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "mupm: %lld steps in %s: %.4g point-steps/s, %.4g bond-updates/s\n",
+                  summary.steps, format_seconds(summary.wall_seconds).c_str(),
+                  double(n_global) * double(summary.steps) / summary.wall_seconds,
+                  double(n_bonds) * double(summary.steps) / summary.wall_seconds);
+    out << line;
+  }
+  return summary;
+}
+
+}  // namespace
+
+RunSummary run_simulation(const Teuchos::RCP<const Teuchos::Comm<int>>& comm,
+                          Teuchos::ParameterList& input, std::ostream& out) {
+  return input_dimension(input) == 2 ? run<2>(comm, input, out) : run<3>(comm, input, out);
+}
+
+}  // namespace mupm

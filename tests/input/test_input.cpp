@@ -1,0 +1,221 @@
+// Input validation: each class of error names the parameter's full path and what was expected;
+// a valid input gets every default; the grid follows from the parameters.
+#include <gtest/gtest.h>
+
+#include <Teuchos_Array.hpp>
+
+#include "mupm/input/input.hpp"
+
+namespace mupm {
+namespace {
+
+// An input with the given Discretization entries and other sublists; a solid's required
+// material constants are added unless `rest` has a Materials sublist.
+std::string xml(const std::string& discretization, const std::string& rest = "") {
+  const std::string materials =
+      rest.find("name=\"Materials\"") != std::string::npos
+          ? ""
+          : "<ParameterList name=\"Materials\">"
+            "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+            "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+            "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+            "</ParameterList>";
+  return "<ParameterList name=\"mupm\"><ParameterList name=\"Discretization\">" + discretization +
+         "</ParameterList>" + materials + rest + "</ParameterList>";
+}
+const std::string kOk =
+    "<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
+    "<Parameter name=\"Counts\" type=\"Array(int)\" value=\"{10, 8}\"/>";
+
+// Validating `text` must throw an InputError whose message contains every piece of `expect`.
+void expect_error(const std::string& text, const std::vector<std::string>& expect) {
+  try {
+    auto pl = parse_input(text);
+    validate_input(*pl);
+    ADD_FAILURE() << "no error for:\n" << text;
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    for (const auto& piece : expect)
+      EXPECT_NE(msg.find(piece), std::string::npos) << "'" << piece << "' not in:\n" << msg;
+  }
+}
+
+TEST(Input, ValidInputGetsDefaults) {
+  auto pl = parse_input(xml(kOk));
+  validate_input(*pl);
+  EXPECT_EQ(pl->sublist("Solver").get<int>("Number of Steps"), 100);
+  EXPECT_EQ(pl->sublist("Output").get<std::string>("Folder"), "output");
+  EXPECT_DOUBLE_EQ(pl->sublist("Discretization").get<double>("Horizon Factor"), 3.015);
+  const auto g = grid_from_input<2>(*pl);
+  EXPECT_EQ(g.counts[0], 10);
+  EXPECT_EQ(g.counts[1], 8);
+  EXPECT_DOUBLE_EQ(g.horizon, 0.03015);
+  EXPECT_EQ(g.n_global(), 80);
+}
+
+TEST(Input, ExtentsLayersRegions) {
+  auto pl = parse_input(
+      xml("<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
+          "<Parameter name=\"Extents\" type=\"Array(double)\" value=\"{0.2, 0.1}\"/>"
+          "<Parameter name=\"Horizon\" type=\"double\" value=\"0.04\"/>"
+          "<Parameter name=\"Boundary Layers\" type=\"Array(string)\" value=\"{-y, +y}\"/>"
+          "<ParameterList name=\"Regions\"><ParameterList name=\"top\">"
+          "<Parameter name=\"Min\" type=\"Array(double)\" value=\"{0, 0.09}\"/>"
+          "<Parameter name=\"Max\" type=\"Array(double)\" value=\"{0.2, 0.1}\"/>"
+          "</ParameterList></ParameterList>"));
+  validate_input(*pl);
+  const auto g = grid_from_input<2>(*pl);
+  EXPECT_EQ(g.counts[0], 20);
+  EXPECT_EQ(g.counts[1], 10);
+  EXPECT_EQ(g.layers[1][0], 8);  // floor(2 horizons: 2 x 0.04 / 0.01)
+  EXPECT_EQ(g.layers[1][1], 8);
+  EXPECT_EQ(g.layers[0][0], 0);
+  ASSERT_EQ(g.region_names.size(), 3u);
+  EXPECT_EQ(g.region_names[0], "top");
+  EXPECT_EQ(g.region_names[1], "Layer -y");
+  EXPECT_EQ(g.region_names[2], "Layer +y");
+}
+
+TEST(Input, UnknownParameter) {
+  expect_error(xml(kOk + "<Parameter name=\"Spacingg\" type=\"double\" value=\"1\"/>"),
+               {"Spacingg", "mupm->Discretization", "not found in the list of valid"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"dt\" type=\"double\" "
+                   "value=\"1\"/></ParameterList>"),
+               {"dt", "mupm->Solver"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Materials\"><Parameter name=\"E\" type=\"double\" "
+                   "value=\"1\"/></ParameterList>"),
+               {"\"E\"", "mupm->Materials"});
+}
+
+TEST(Input, UnknownParameterInNamedSublist) {
+  expect_error(xml(kOk + "<ParameterList name=\"Regions\"><ParameterList name=\"top\">"
+                         "<Parameter name=\"Minimum\" type=\"Array(double)\" value=\"{0, 0}\"/>"
+                         "</ParameterList></ParameterList>"),
+               {"Minimum", "mupm->Discretization->Regions->top"});
+}
+
+TEST(Input, WrongType) {
+  expect_error(xml("<Parameter name=\"Spacing\" type=\"string\" value=\"small\"/>"
+                   "<Parameter name=\"Counts\" type=\"Array(int)\" value=\"{10, 8}\"/>"),
+               {"Spacing", "mupm->Discretization", "double"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"Number of Steps\" "
+                   "type=\"double\" value=\"1.5\"/></ParameterList>"),
+               {"Number of Steps", "mupm->Solver", "int"});
+}
+
+TEST(Input, OutOfRange) {
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"Time Step\" "
+                   "type=\"double\" value=\"-1e-6\"/></ParameterList>"),
+               {"Time Step", "mupm->Solver", "-1e-06"});
+  expect_error(xml(kOk + "<Parameter name=\"Dimension\" type=\"int\" value=\"4\"/>"),
+               {"Dimension", "mupm->Discretization"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Output\"><Parameter name=\"Fields\" "
+                   "type=\"Array(string)\" value=\"{displacement, temperature}\"/>"
+                   "</ParameterList>"),
+               {"Fields", "mupm->Output", "temperature"});
+}
+
+TEST(Input, MissingRequired) {
+  expect_error(xml("<Parameter name=\"Counts\" type=\"Array(int)\" value=\"{10, 8}\"/>"),
+               {"mupm->Discretization->Spacing", "missing"});
+  expect_error(xml("<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"),
+               {"mupm->Discretization", "Counts", "Extents"});
+  expect_error("<ParameterList name=\"mupm\"/>", {"mupm->Discretization", "missing"});
+}
+
+TEST(Input, InconsistentValues) {
+  expect_error(xml("<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
+                   "<Parameter name=\"Counts\" type=\"Array(int)\" value=\"{10, 8, 3}\"/>"),
+               {"mupm->Discretization->Counts", "2 values"});
+  expect_error(xml("<Parameter name=\"Spacing\" type=\"double\" value=\"0.03\"/>"
+                   "<Parameter name=\"Extents\" type=\"Array(double)\" value=\"{0.1, 0.09}\"/>"),
+               {"mupm->Discretization->Extents", "whole multiple"});
+  expect_error(xml(kOk + "<Parameter name=\"Boundary Layers\" type=\"Array(string)\" "
+                         "value=\"{+z}\"/>"),
+               {"Boundary Layers", "+z"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Initial Conditions\"><ParameterList name=\"v\">"
+                   "<Parameter name=\"Field\" type=\"string\" value=\"Velocity\"/>"
+                   "<Parameter name=\"Region\" type=\"string\" value=\"nowhere\"/>"
+                   "<Parameter name=\"Value\" type=\"Array(double)\" value=\"{1, 0}\"/>"
+                   "</ParameterList></ParameterList>"),
+               {"mupm->Initial Conditions->v->Region", "nowhere"});
+}
+
+TEST(Input, NumbersAreReadStrictly) {
+  // Teuchos alone would read these as 0.
+  expect_error(xml(kOk + "<Parameter name=\"Origin\" type=\"Array(double)\" value=\"{0, abc}\"/>"),
+               {"mupm->Discretization->Origin", "abc", "not a finite double"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"Time Step\" "
+                   "type=\"double\" value=\"1e-3x\"/></ParameterList>"),
+               {"mupm->Solver->Time Step", "1e-3x"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Solver\"><Parameter name=\"Number of Steps\" "
+                   "type=\"int\" value=\"10.5\"/></ParameterList>"),
+               {"mupm->Solver->Number of Steps", "not a finite int"});
+  expect_error(xml(kOk + "<Parameter name=\"Horizon\" type=\"double\" value=\"nan\"/>"),
+               {"mupm->Discretization->Horizon", "nan"});
+}
+
+TEST(Input, SolidAndBoundaryConditions) {
+  // A solid needs its moduli and length scale.
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Materials\"><Parameter name=\"Bulk Modulus\" "
+                   "type=\"double\" value=\"1e8\"/></ParameterList>"),
+               {"mupm->Materials->Shear Modulus", "> 0"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"b\">"
+                   "<Parameter name=\"Type\" type=\"string\" value=\"Micro-Rotation\"/>"
+                   "<Parameter name=\"Component\" type=\"string\" value=\"x\"/>"
+                   "</ParameterList></ParameterList>"),
+               {"mupm->Boundary Conditions->b->Component", "about z"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"b\">"
+                   "<Parameter name=\"Time Function\" type=\"string\" value=\"Table\"/>"
+                   "<Parameter name=\"Times\" type=\"Array(double)\" value=\"{0, 1}\"/>"
+                   "</ParameterList></ParameterList>"),
+               {"mupm->Boundary Conditions->b", "Table"});
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"b\">"
+                   "<Parameter name=\"Type\" type=\"string\" value=\"Pressure\"/>"
+                   "</ParameterList></ParameterList>"),
+               {"Type", "mupm->Boundary Conditions->b", "Pressure"});
+  auto pl =
+      parse_input(xml(kOk,
+                      "<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"pull\">"
+                      "<Parameter name=\"Component\" type=\"string\" value=\"y\"/>"
+                      "<Parameter name=\"Value\" type=\"double\" value=\"2\"/>"
+                      "<Parameter name=\"Time Function\" type=\"string\" value=\"Table\"/>"
+                      "<Parameter name=\"Times\" type=\"Array(double)\" value=\"{0, 1, 3}\"/>"
+                      "<Parameter name=\"Values\" type=\"Array(double)\" value=\"{0, 1, 0}\"/>"
+                      "</ParameterList></ParameterList>"));
+  validate_input(*pl);
+  const auto bcs = boundary_conditions_from_input(*pl);
+  ASSERT_EQ(bcs.size(), 1u);
+  EXPECT_EQ(bcs[0].component, 1);
+  EXPECT_EQ(bcs[0].kind, BoundaryCondition::Displacement);
+  EXPECT_DOUBLE_EQ(bcs[0].time(0.5), 0.5);  // piecewise-linear table
+  EXPECT_DOUBLE_EQ(bcs[0].time(2.0), 0.5);
+  EXPECT_DOUBLE_EQ(bcs[0].time(5.0), 0.0);  // held after the table
+  EXPECT_DOUBLE_EQ(bcs[0].time.rate(2.0), -0.5);
+}
+
+TEST(Input, MalformedXml) {
+  EXPECT_THROW(parse_input("<ParameterList name=\"mupm\"><Parameter name="), InputError);
+}
+
+TEST(Input, PrintDefaultsRoundTrip) {
+  // The defaults list is itself an input that validates (after adding the required values).
+  auto defaults = valid_parameters();
+  EXPECT_TRUE(defaults->sublist("Discretization").isParameter("Spacing"));
+  EXPECT_FALSE(defaults->sublist("Discretization").getEntry("Spacing").docString().empty());
+}
+
+}  // namespace
+}  // namespace mupm
