@@ -5,7 +5,9 @@
 
 Every parameter that `mupm --print-defaults` prints must have a row in the tables of the
 README's "## Input reference" section (tables headed `| parameter | type | default | meaning |`),
-and every parameter those tables name must exist.
+and every parameter those tables name must exist. For a parameter with a list of choices (its
+validator's strings: enumerated options, the registry's output fields and initial-condition
+names), every choice must appear in its README row.
 Prints each missing or extra parameter with its full path (mupm->Solver->Time Step); exit 0
 when they agree, 1 otherwise.
 
@@ -48,17 +50,27 @@ def print_defaults(mupm):
         root = ET.fromstring(out[start:end + len("</ParameterList>")])
     except ET.ParseError as e:
         sys.exit("FAIL: %s --print-defaults printed invalid XML: %s" % (mupm, e))
+    # The choices of each validator: StringIntegralValidator <String stringValue=...>,
+    # StringValidator <String value=...>, also inside an ArrayValidator.
+    choices = {}
+    for v in root.iter("Validator"):
+        if v.get("validatorId") is None:
+            continue
+        names = [e.get("stringValue") or e.get("value") for e in v.iter("String")]
+        if names:
+            choices[v.get("validatorId")] = [n for n in names if n]
     params = []
 
     def walk(plist, path):
         for child in plist:  # Parameter and ParameterList; <Validators> is not an entry
             if child.tag == "Parameter":
-                params.append(path + [child.get("name")])
+                params.append(("->".join(path + [child.get("name")]),
+                               choices.get(child.get("validatorId"), [])))
             elif child.tag == "ParameterList":
                 walk(child, path + [child.get("name")])
 
     walk(root, [root.get("name")])
-    return ["->".join(p) for p in params]
+    return params
 
 
 def split_path(text):
@@ -100,7 +112,8 @@ def readme_parameters(readme):
             sys.exit("FAIL: %s:%d: a table row before any ### heading" % (readme, i + 1))
         path = split_path(first_cell)
         for name in path[-1].split(","):
-            params.append(("->".join(["mupm"] + heading + path[:-1] + [name.strip()]), i + 1))
+            params.append(("->".join(["mupm"] + heading + path[:-1] + [name.strip()]), i + 1,
+                           line))
     return params
 
 
@@ -108,23 +121,29 @@ def main():
     if len(sys.argv) != 3:
         sys.exit("usage: check_readme_parameters.py MUPM_EXECUTABLE README.md")
     mupm, readme = sys.argv[1:]
-    program = print_defaults(mupm)
+    program = dict(print_defaults(mupm))
     documented = readme_parameters(readme)
     if not program:
         sys.exit("FAIL: %s --print-defaults printed no parameter" % mupm)
-    doc_paths = {p for p, _ in documented}
-    missing = [p for p in program if p not in doc_paths]
-    extra = [(p, line) for p, line in documented if p not in set(program)]
+    doc_rows = {p: (line, text) for p, line, text in documented}
+    missing = [p for p in program if p not in doc_rows]
+    extra = [(p, line) for p, line, _ in documented if p not in program]
+    # A choice counts as documented when it appears in the row as a word (not inside another).
+    undocumented = [(p, c, doc_rows[p][0]) for p, cs in program.items() if p in doc_rows
+                    for c in cs if not re.search(r"(?<![\w-])" + re.escape(c) + r"(?![\w-])",
+                                                 doc_rows[p][1])]
     for p in missing:
         print("missing from %s: %s" % (readme, p))
     for p, line in extra:
         print("not a parameter (%s:%d): %s" % (readme, line, p))
-    if missing or extra:
-        print("FAIL: %d parameter(s) missing from the README's input reference, %d extra"
-              % (len(missing), len(extra)))
+    for p, c, line in undocumented:
+        print("choice not in the README row (%s:%d): %s = %s" % (readme, line, p, c))
+    if missing or extra or undocumented:
+        print("FAIL: %d parameter(s) missing from the README's input reference, %d extra, "
+              "%d choice(s) undocumented" % (len(missing), len(extra), len(undocumented)))
         return 1
-    print("README input reference matches mupm --print-defaults: %d parameters checked"
-          % len(program))
+    print("README input reference matches mupm --print-defaults: %d parameters and %d choices "
+          "checked" % (len(program), sum(len(c) for c in program.values())))
     return 0
 
 
