@@ -121,6 +121,17 @@ struct Assembly {
       m.push_back(fluid.get());
     return m;
   }
+  // Module set-up in the order the coupling needs: the fluid (S_r, C, flow of the state), then
+  // the mechanics, whose tr(eps) of the initial state is the fluid's reference.
+  void initialize(double time, bool restarted) {
+    if (fluid)
+      fluid->initialize(time, restarted);
+    if (mechanics) {
+      mechanics->initialize(time, restarted);
+      if (fluid && !restarted)
+        fluid->reset_strain_reference();
+    }
+  }
   NamedGlobals globals() const {
     NamedGlobals out;
     for (Module* m : modules()) {
@@ -164,22 +175,51 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   return ph;
 }
 
+// Prints the size of the discretization; returns the global number of bonds.
+template <int Dim>
+long long report_discretization(const Discretization<Dim>& disc, const Teuchos::Comm<int>& comm,
+                                std::ostream& out) {
+  long long counts[2] = {static_cast<long long>(disc.bonds.size()),
+                         static_cast<long long>(disc.points.n_ghost)};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_LONG_LONG, MPI_SUM, io::raw(comm));
+  const auto& g = disc.grid;
+  if (comm.getRank() == 0)
+    out << "mupm: " << Dim << "D, " << disc.dist.n_global() << " points (" << counts[1]
+        << " ghost copies), " << counts[0] << " bonds, dx = " << g.dx
+        << " m, horizon = " << g.horizon << " m (" << g.horizon / g.dx << " dx)\n"
+        << "mupm: " << comm.getSize() << " rank(s) x " << ExecSpace().concurrency() << " "
+        << ExecSpace::name() << " thread(s); " << Points<Dim>::bytes_per_point()
+        << " bytes per point, " << Bonds::bytes_per_bond() << " bytes per bond\n";
+  return counts[0];
+}
+
+// The initial fields: Materials->Porosity, saturated, then the initial conditions in order.
+template <int Dim>
+void initial_state(const Model<Dim>& model, Points<Dim>& pts) {
+  Kokkos::deep_copy(pts.porosity, model.porosity);
+  Kokkos::deep_copy(pts.saturation, 1.0);
+  Kokkos::Array<double, 3> rho_w_g{};
+  for (int k = 0; k < 3; ++k)
+    rho_w_g[k] = model.fluid.water_density * model.gravity[k];
+  apply_initial_conditions(model.initial_conditions, pts, rho_w_g);
+}
+
 // The time step and the fluid's substeps from the modules' stable-step estimates (Automatic
 // Time Step, Fluid Substeps = 0), with warnings where the given ones exceed them.
 template <int Dim>
 double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, int rank, std::ostream& out) {
   const double safety = run.safety;
   double dt = run.time_step;
-  auto* solid = dynamic_cast<SolidSolver<Dim>*>(ph.mechanics.get());
+  Mechanics* solid =
+      ph.mechanics && ph.mechanics->limits_time_step() ? ph.mechanics.get() : nullptr;
   if (solid) {
     const double stiffening = ph.fluid ? ph.fluid->undrained_stiffening() : 0.0;
     const double stable = three_digits(solid->stable_time_step());
     if (run.automatic_time_step)
       dt = safety * stable;
     if (rank == 0) {
-      out << "mupm: micropolar solid, stabilization G = " << solid->params().stabilization
-          << ", D = " << solid->params().stab_modulus << " Pa/m^2; estimated stable dt = " << stable
-          << " s" << (ph.fluid ? " (undrained: the pore water adds up to " : "");
+      out << "mupm: " << solid->describe() << "; estimated stable dt = " << stable << " s"
+          << (ph.fluid ? " (undrained: the pore water adds up to " : "");
       if (ph.fluid)
         out << stiffening << " Pa to the bulk modulus)";
       out << "; dt = " << dt << " s\n";
@@ -315,25 +355,9 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
 
   Discretization<Dim> disc = discretize(comm, model.grid);
   Points<Dim>& pts = disc.points;
-  long long counts[2] = {static_cast<long long>(disc.bonds.size()),
-                         static_cast<long long>(pts.n_ghost)};
-  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_LONG_LONG, MPI_SUM, mpi);
-  const long long n_bonds = counts[0], n_global = disc.dist.n_global();
-  if (rank == 0)
-    out << "mupm: " << Dim << "D, " << n_global << " points (" << counts[1] << " ghost copies), "
-        << n_bonds << " bonds, dx = " << model.grid.dx << " m, horizon = " << model.grid.horizon
-        << " m (" << model.grid.horizon / model.grid.dx << " dx)\n"
-        << "mupm: " << comm->getSize() << " rank(s) x " << ExecSpace().concurrency() << " "
-        << ExecSpace::name() << " thread(s); " << Points<Dim>::bytes_per_point()
-        << " bytes per point, " << Bonds::bytes_per_bond() << " bytes per bond\n";
-
-  // Initial state (saturated unless an initial condition says otherwise), or the checkpoint's.
-  Kokkos::deep_copy(pts.porosity, model.porosity);
-  Kokkos::deep_copy(pts.saturation, 1.0);
-  Kokkos::Array<double, 3> rho_w_g{};
-  for (int k = 0; k < 3; ++k)
-    rho_w_g[k] = model.fluid.water_density * model.gravity[k];
-  apply_initial_conditions(model.initial_conditions, pts, rho_w_g);
+  const long long n_bonds = report_discretization(disc, *comm, out);
+  const long long n_global = disc.dist.n_global();
+  initial_state(model, pts);
   Assembly<Dim> ph = assemble(model, disc, mpi);
   long long step = 0;
   double time = 0;
@@ -346,13 +370,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   }
   ph.damage->update();
   disc.dist.refresh(pts.double_fields(kGhosted));
-  if (ph.fluid)
-    ph.fluid->initialize(time, restarted);
-  if (auto* solid = dynamic_cast<SolidSolver<Dim>*>(ph.mechanics.get())) {
-    solid->initialize(time, restarted);
-    if (ph.fluid && !restarted)
-      ph.fluid->reset_strain_reference();
-  }
+  ph.initialize(time, restarted);
   const double dt = choose_time_step(run, ph, rank, out);
 
   FieldOutput<Dim> fields(run.folder, disc, run.fields, history);

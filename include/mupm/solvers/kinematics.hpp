@@ -21,6 +21,7 @@ class Kinematics : public Mechanics {
     Kokkos::deep_copy(unit_, 1.0);
   }
   const char* name() const override { return "kinematics"; }
+  void initialize(double, bool) override {}
   void step(double, double dt) override {
     auto& p = disc_.points;
     advance_positions(p, dt);

@@ -61,9 +61,15 @@ class Module {
 // What advances u and theta in a step (the micropolar solid, or kinematics alone).
 class Mechanics : public Module {
  public:
+  // Boundary values and the forces of the state at t; at a start (not a restart, whose state
+  // holds them) also the accelerations.
+  virtual void initialize(double t, bool restarted) = 0;
   virtual void step(double t, double dt) = 0;
-  // Largest stable step of the explicit scheme (0: no limit).
+  // Whether the scheme has a stability limit, and the largest stable step (collective).
+  virtual bool limits_time_step() const { return false; }
   virtual double stable_time_step() { return 0.0; }
+  // One line on the model and its constants, for the run's report.
+  virtual std::string describe() const { return name(); }
   // Mixture density and micro-inertia after the fluid changed the saturation (eq 1).
   virtual void update_density() {}
 };

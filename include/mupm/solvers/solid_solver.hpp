@@ -6,6 +6,7 @@
 #include <mpi.h>
 
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -126,7 +127,7 @@ class SolidSolver : public Mechanics {
   // Marks prescribed components, computes densities (eqs 1, 13) from porosity and saturation,
   // and the forces of the current state; at a start (not a restart, whose state holds them)
   // also the boundary values at t and the accelerations.
-  void initialize(double t, bool restarted) {
+  void initialize(double t, bool restarted) override {
     auto& p = disc_.points;
     mark_fixed(bcs_, p);
     update_density();
@@ -235,7 +236,14 @@ class SolidSolver : public Mechanics {
   // from below). The state is restored afterwards.
   // With a fluid the operator includes the undrained stiffness S_r^2 / C of the undrained split
   // (include/mupm/kernels/solid.hpp): the fastest waves are the undrained ones.
+  bool limits_time_step() const override { return true; }
   double stable_time_step() override { return estimate_stable_dt(); }
+  std::string describe() const override {
+    std::ostringstream s;
+    s << "micropolar solid, stabilization G = " << prm_.stabilization
+      << ", D = " << prm_.stab_modulus << " Pa/m^2";
+    return s.str();
+  }
   double estimate_stable_dt(int iterations = 40) {
     ScopedRegion region("mupm::Solid::stable_step");
     auto& p = disc_.points;
