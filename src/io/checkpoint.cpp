@@ -78,11 +78,19 @@ constexpr bool storable() {
   return std::is_same_v<T, double> || std::is_same_v<T, unsigned char> ||
          std::is_same_v<T, long long> || std::is_same_v<T, int>;
 }
-template <class V>
-void require_storable(const FieldSpec& s) {
-  if (!storable<V>())
-    throw std::logic_error(std::string("checkpointed field ") + s.name +
-                           " has a type the checkpoint cannot store");
+// f(view, spec) for every checkpointed field of a registry (Points or Bonds).
+template <class Registry, class F>
+void for_each_checkpointed(Registry& r, F&& f) {
+  r.for_each_field([&](auto& view, const FieldSpec& s) {
+    using V = std::decay_t<decltype(view)>;
+    if (!s.has(kCheckpoint))
+      return;
+    if constexpr (storable<V>())
+      f(view, s);
+    else
+      throw std::logic_error(std::string("checkpointed field ") + s.name +
+                             " has a type the checkpoint cannot store");
+  });
 }
 
 std::vector<GlobalId> owned_gids(const GlobalIds& gid, std::size_t n_owned) {
@@ -114,27 +122,15 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
     file.write_global("output_history", output_history);
     for (const auto& [name, value] : globals)
       file.write_global("globals/" + name, {*value});
-    disc.points.for_each_field([&](const auto& view, const FieldSpec& s) {
-      using V = std::decay_t<decltype(view)>;
-      if (!s.has(kCheckpoint))
-        return;
-      require_storable<V>(s);
-      if constexpr (storable<V>()) {
-        const auto rows = io::owned_rows(view, n);
-        file.write_points(std::string("points/") + s.name, gids, n_global, s.ncomp, rows.data());
-      }
+    for_each_checkpointed(disc.points, [&](const auto& view, const FieldSpec& s) {
+      const auto rows = io::owned_rows(view, n);
+      file.write_points(std::string("points/") + s.name, gids, n_global, s.ncomp, rows.data());
     });
     const auto t = bond_layout(disc, comm);
     file.write_points("bonds/neighbor_gid", gids, n_global, t.width, t.neighbor_gid.data());
-    disc.bonds.for_each_field([&](const auto& view, const FieldSpec& s) {
-      using V = std::decay_t<decltype(view)>;
-      if (!s.has(kCheckpoint))
-        return;
-      require_storable<V>(s);
-      if constexpr (storable<V>()) {
-        const auto rows = to_table(view, disc.bonds.offsets, n, t.width);
-        file.write_points(std::string("bonds/") + s.name, gids, n_global, t.width, rows.data());
-      }
+    for_each_checkpointed(disc.bonds, [&](const auto& view, const FieldSpec& s) {
+      const auto rows = to_table(view, disc.bonds.offsets, n, t.width);
+      file.write_points(std::string("bonds/") + s.name, gids, n_global, t.width, rows.data());
     });
   }
   // Replace the previous checkpoint only once the new one is complete.
@@ -193,16 +189,10 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
                             "conditions than this input's.");
     *value = file.read_global("globals/" + name).at(0);
   }
-  disc.points.for_each_field([&](const auto& view, const FieldSpec& s) {
-    using V = std::decay_t<decltype(view)>;
-    if (!s.has(kCheckpoint))
-      return;
-    require_storable<V>(s);
-    if constexpr (storable<V>()) {
-      std::vector<typename V::value_type> rows(n * std::size_t(s.ncomp));
-      file.read_points(std::string("points/") + s.name, gids, s.ncomp, rows.data());
-      io::set_owned_rows(view, n, rows);
-    }
+  for_each_checkpointed(disc.points, [&](const auto& view, const FieldSpec& s) {
+    std::vector<typename std::decay_t<decltype(view)>::value_type> rows(n * std::size_t(s.ncomp));
+    file.read_points(std::string("points/") + s.name, gids, s.ncomp, rows.data());
+    io::set_owned_rows(view, n, rows);
   });
   // The bonds must be the same ones (same neighbours in the same order) for the state to apply.
   const auto t = bond_layout(disc, comm);
@@ -214,16 +204,10 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
     throw CollectiveError(where +
                           "holds other bonds than this input makes (horizon, pre-cracks or "
                           "grid differ).");
-  disc.bonds.for_each_field([&](const auto& view, const FieldSpec& s) {
-    using V = std::decay_t<decltype(view)>;
-    if (!s.has(kCheckpoint))
-      return;
-    require_storable<V>(s);
-    if constexpr (storable<V>()) {
-      std::vector<typename V::value_type> rows(t.neighbor_gid.size());
-      file.read_points(std::string("bonds/") + s.name, gids, t.width, rows.data());
-      from_table(view, disc.bonds.offsets, n, t.width, rows);
-    }
+  for_each_checkpointed(disc.bonds, [&](const auto& view, const FieldSpec& s) {
+    std::vector<typename std::decay_t<decltype(view)>::value_type> rows(t.neighbor_gid.size());
+    file.read_points(std::string("bonds/") + s.name, gids, t.width, rows.data());
+    from_table(view, disc.bonds.offsets, n, t.width, rows);
   });
   disc.update_shape();
 }
