@@ -499,6 +499,22 @@ void check_dimension_arrays(ParameterList& input) {
       !d.getEntry("Horizon Factor").isDefault())
     throw InputError("Error, " + d.name() +
                      " gives both Horizon and Horizon Factor: give one of the two.");
+  // Lattice neighbours are one spacing apart: a smaller horizon leaves every point without a
+  // bond (and a stable step of 0).
+  {
+    const double dx = d.get<double>("Spacing"), h = d.get<double>("Horizon");
+    const bool given = h > 0;
+    const double horizon = given ? h : d.get<double>("Horizon Factor") * dx;
+    if (horizon < dx * (1 - 1e-9)) {
+      std::ostringstream s;
+      s << "Error, " << path_of(d, given ? "Horizon" : "Horizon Factor") << " = "
+        << (given ? h : d.get<double>("Horizon Factor")) << " gives a horizon of " << horizon
+        << " m, below the spacing " << dx
+        << " m: no point would have a bond. The horizon must be at least one spacing (3.015 "
+           "spacings is usual).";
+      throw InputError(s.str());
+    }
+  }
   const Array<std::string> faces = d.get<Array<std::string>>("Boundary Layers");
   for (const auto& f : faces)
     if (f.size() == 2 && (f[1] - 'x') >= dim)

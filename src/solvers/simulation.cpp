@@ -112,6 +112,7 @@ struct Assembly {
   std::unique_ptr<Mechanics> mechanics;  // the micropolar solid, kinematics, or none
   std::unique_ptr<Damage<Dim>> damage;
   StepSequence<Dim> sequence;
+  double spacing = 0;  // dx, for messages
   // Time series, restart globals and energy balances, in the time series' column order.
   std::vector<Module*> modules() const {
     std::vector<Module*> m{damage.get()};
@@ -167,6 +168,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
     ph.mechanics = std::make_unique<Kinematics<Dim>>(disc);
   }
   ph.damage = std::make_unique<Damage<Dim>>(disc, mpi);
+  ph.spacing = disc.grid.dx;
   ph.sequence.mechanics = ph.mechanics.get();
   ph.sequence.fluid = ph.fluid.get();
   ph.sequence.damage = ph.damage.get();
@@ -204,6 +206,25 @@ void initial_state(const Model<Dim>& model, Points<Dim>& pts) {
   apply_initial_conditions(model.initial_conditions, pts, rho_w_g);
 }
 
+// The most fluid substeps per fluid interval a run may take (each costs about a solid step).
+constexpr double kMaxFluidSubsteps = 1e6;
+
+// Why automatic fluid substeps cannot run: the fluid is too stiff for the time step.
+std::string too_stiff(const FluidParams& f, double dx, double stable_f, double interval,
+                      double needed) {
+  std::ostringstream s;
+  s << "Error, the pore fluid's estimated stable step is " << stable_f << " s: a fluid interval of "
+    << interval << " s would need " << needed
+    << " substeps (Solver->Fluid Substeps = 0), beyond the " << kMaxFluidSubsteps
+    << " a run can take. The fluid is that stiff through k/mu_w = " << f.mobility
+    << " m^2/(Pa s) (mupm->Fluid->Hydraulic Conductivity, or Intrinsic Permeability / Viscosity), "
+       "K_w = "
+    << f.bulk_modulus << " Pa (mupm->Fluid->Fluid Bulk Modulus) and dx = " << dx
+    << " m (mupm->Discretization->Spacing): the stable step scales as dx^2 C / (k/mu_w), C ~ "
+       "phi/K_w. Check those values, or use a smaller Solver->Time Step.";
+  return s.str();
+}
+
 // The time step and the fluid's substeps from the modules' stable-step estimates (Automatic
 // Time Step, Fluid Substeps = 0), with warnings where the given ones exceed them.
 template <int Dim>
@@ -237,8 +258,13 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, int rank, std
     const int every = ph.sequence.fluid_every;
     const double interval = every * dt;
     int substeps = run.fluid_substeps;
-    if (substeps == 0)
-      substeps = std::max(1, int(std::ceil(interval / (safety * stable_f) - 1e-9)));
+    if (substeps == 0) {
+      // In double: a stiff fluid can need more substeps than an int holds.
+      const double needed = std::ceil(interval / (safety * stable_f) - 1e-9);
+      if (!(needed <= kMaxFluidSubsteps && stable_f > 0 && dt > 0))
+        throw InputError(too_stiff(fluid.params(), ph.spacing, stable_f, interval, needed));
+      substeps = std::max(1, int(needed));
+    }
     ph.sequence.substeps = substeps;
     const double dt_f = interval / substeps;
     if (rank == 0) {

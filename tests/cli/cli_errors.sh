@@ -88,6 +88,17 @@ cat >>inf.xml <<'XML'
 </ParameterList>
 XML
 expect inf 3 'NaN or Inf at step 1' 'global id' 'reference position'
+# A fluid too stiff for automatic substeps (~4e9 of them: the count once overflowed to 1 and the
+# run ended with p ~ 1e173 Pa and exit 0) is refused before the first step, naming the
+# parameters.
+sed -e 's|value="{6, 40}"|value="{6, 12}"|' \
+    -e 's|name="Hydraulic Conductivity" type="double" value="5.11e-5"|name="Hydraulic Conductivity" type="double" value="5.11e3"|' \
+    -e 's|name="Number of Steps" type="int" value="3740"|name="Number of Steps" type="int" value="5"|' \
+    -e 's|name="Folder" type="string" value="[^"]*"|name="Folder" type="string" value="stiff"|' \
+    "$SRC/inputs/consolidation.xml" >stiff_fluid.xml
+grep -q 'value="5.11e3"' stiff_fluid.xml || fail "inputs/consolidation.xml changed: stiff_fluid.xml not derived"
+expect stiff_fluid 2 'substeps' 'mupm->Fluid->Hydraulic Conductivity' 'mupm->Fluid->Fluid Bulk Modulus'
+[[ -e stiff/fields_000000005.h5 ]] && fail "stiff_fluid: the run stepped"
 # A missing checkpoint stops both ranks cleanly (exit 3, no abort).
 base '' '<Parameter name="Restart From" type="string" value="nowhere/checkpoint.h5"/>' >no_checkpoint.xml
 expect no_checkpoint 3 'nowhere/checkpoint.h5'

@@ -147,6 +147,18 @@ TEST(Input, InconsistentValues) {
                {"mupm->Initial Conditions->v->Region", "nowhere"});
 }
 
+// A horizon below the spacing gives no bonds (a run would take steps of 0 s): refused, naming
+// the parameter that set it.
+TEST(Input, HorizonBelowSpacingIsRefused) {
+  expect_error(xml(kOk + "<Parameter name=\"Horizon Factor\" type=\"double\" value=\"0.5\"/>"),
+               {"mupm->Discretization->Horizon Factor", "0.005 m", "no point would have a bond"});
+  expect_error(xml(kOk + "<Parameter name=\"Horizon\" type=\"double\" value=\"0.001\"/>"),
+               {"mupm->Discretization->Horizon =", "below the spacing 0.01 m"});
+  // One spacing exactly still bonds the nearest neighbours.
+  auto pl = parse_input(xml(kOk + "<Parameter name=\"Horizon Factor\" type=\"double\" value=\"1\"/>"));
+  EXPECT_NO_THROW(validate_input(*pl));
+}
+
 TEST(Input, NumbersAreReadStrictly) {
   // Teuchos alone would read these as 0.
   expect_error(xml(kOk + "<Parameter name=\"Origin\" type=\"Array(double)\" value=\"{0, abc}\"/>"),
