@@ -1,9 +1,12 @@
 // mupm: micro-periporomechanics simulations driven by a Teuchos XML input.
+#include <mpi.h>
 #include <Teuchos_DefaultComm.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
 #include <Tpetra_Core.hpp>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <string>
 
 #include "mupm/input/input.hpp"
 #include "mupm/solvers/simulation.hpp"
@@ -19,56 +22,80 @@ const char* kUsage =
     "(also OMP_PROC_BIND=spread OMP_PLACES=threads). Kokkos options (--kokkos-...) are accepted.\n"
     "Exit codes: 0 success, 1 usage, 2 input error, 3 run-time error.\n";
 
+// Writes the input's verdict or the defaults without starting Kokkos, whose start-up chatter
+// (affinity warnings, its --help banner) would otherwise land in stdout before them.
+int without_kokkos(const std::string& mode, const std::string& path, int argc, char* argv[]) {
+  MPI_Init(&argc, &argv);
+  int code = 0;
+  {
+    auto comm = Teuchos::DefaultComm<int>::getComm();
+    const bool root = comm->getRank() == 0;
+    if (mode == "help") {
+      if (root)
+        std::cout << kUsage;
+    } else if (mode == "defaults") {
+      if (root)
+        Teuchos::writeParameterListToXmlOStream(*mupm::valid_parameters(), std::cout);
+    } else {
+      try {
+        auto input = mupm::read_input(*comm, path);
+        mupm::validate_input(*input);
+        if (root)
+          std::cout << "mupm: " << path << " is valid\n";
+      } catch (const mupm::InputError& e) {
+        if (root)
+          std::cerr << "mupm: input error in " << path << ":\n" << e.what() << "\n";
+        code = 2;
+      }
+    }
+  }
+  MPI_Finalize();
+  return code;
+}
+
 }  // namespace
 
 int main(int argc, char* argv[]) {
-  Tpetra::ScopeGuard scope(&argc, &argv);
-  auto comm = Tpetra::getDefaultComm();
-  const bool root = comm->getRank() == 0;
+  // Usage errors come before MPI starts: print them once, on Open MPI's rank 0 (or when run
+  // without mpirun).
+  const char* rank_env = std::getenv("OMPI_COMM_WORLD_RANK");
+  const bool first = !rank_env || std::string(rank_env) == "0";
   std::string mode = "run", path;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
-    if (a == "--help" || a == "-h") {
+    if (a.rfind("--kokkos", 0) == 0) {
+      continue;  // Kokkos' own options, taken by Kokkos when it starts
+    } else if (a == "--help" || a == "-h") {
       mode = "help";
     } else if (a == "--print-defaults") {
       mode = "defaults";
     } else if (a == "--validate") {
       mode = "validate";
     } else if (!a.empty() && a[0] == '-') {
-      if (root)
+      if (first)
         std::cerr << "mupm: unknown option " << a << "\n" << kUsage;
       return 1;
     } else if (path.empty()) {
       path = a;
     } else {
-      if (root)
+      if (first)
         std::cerr << "mupm: more than one input file given\n" << kUsage;
       return 1;
     }
   }
-  if (mode == "help") {
-    if (root)
-      std::cout << kUsage;
-    return 0;
-  }
-  if (mode == "defaults") {
-    if (root)
-      Teuchos::writeParameterListToXmlOStream(*mupm::valid_parameters(), std::cout);
-    return 0;
-  }
-  if (path.empty()) {
-    if (root)
+  if ((mode == "run" || mode == "validate") && path.empty()) {
+    if (first)
       std::cerr << "mupm: no input file given\n" << kUsage;
     return 1;
   }
+  if (mode != "run")
+    return without_kokkos(mode, path, argc, argv);
+  Tpetra::ScopeGuard scope(&argc, &argv);
+  auto comm = Tpetra::getDefaultComm();
+  const bool root = comm->getRank() == 0;
   try {
     auto input = mupm::read_input(*comm, path);
     mupm::validate_input(*input);
-    if (mode == "validate") {
-      if (root)
-        std::cout << "mupm: " << path << " is valid\n";
-      return 0;
-    }
     mupm::run_simulation(comm, *input, std::cout);
   } catch (const mupm::InputError& e) {
     if (root)

@@ -106,7 +106,13 @@ grep -q "MPI_ABORT" no_checkpoint.out && fail "no_checkpoint: aborted instead of
 # A valid input validates, and --print-defaults is XML that documents every parameter.
 base '' '' >valid.xml
 run 2 1 --validate valid.xml | grep -q "is valid" || fail "--validate of a valid input"
-"$MUPM" --print-defaults >defaults.xml
+# stdout of --print-defaults, --help and --validate holds their output alone, whatever the OpenMP
+# environment (Kokkos warned about OMP_PROC_BIND into stdout, making defaults.xml invalid XML).
+env -u OMP_PROC_BIND -u OMP_PLACES "$MUPM" --print-defaults >defaults.xml
+env -u OMP_PROC_BIND "$MUPM" --help >help.out
+head -n 1 help.out | grep -q "^usage: mupm" || { cat help.out; fail "--help: stdout does not start with the usage"; }
+env -u OMP_PROC_BIND "$MUPM" --validate valid.xml >validate.out
+[[ $(cat validate.out) == "mupm: valid.xml is valid" ]] || { cat validate.out; fail "--validate: stdout is not the verdict alone"; }
 "$PYTHON" - defaults.xml <<'PY'
 import sys, xml.etree.ElementTree as ET
 root = ET.parse(sys.argv[1]).getroot()
