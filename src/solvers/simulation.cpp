@@ -295,14 +295,48 @@ class StepChecks {
 
   void operator()(const std::vector<Module*>& modules, long long steps_done, long long step,
                   double time) {
-    for (Module* m : modules)
-      for (const auto& b : m->energy_balances())
-        energy(b, steps_done, step, time);
     if (run_.check_finite)
       finite(step, time);
+    for (Module* m : modules)
+      for (const auto& b : m->energy_balances()) {
+        diverged(b, step, time);
+        energy(b, steps_done, step, time);
+      }
+  }
+
+  // At the end of the run: the state is finite whatever Diagnostics->Check Finite says (a run
+  // never ends with exit 0 on NaN), and how many energy warnings there were.
+  void finish(long long step, double time) {
+    finite(step, time);
+    for (const auto& [what, n] : warnings_)
+      if (rank_ == 0 && n > kShownWarnings)
+        out_ << "mupm: " << n << " " << what << " energy-balance warnings in all ("
+             << kShownWarnings << " shown in full, then every 1000th)\n";
   }
 
  private:
+  static constexpr long long kShownWarnings = 5;
+  // A stored energy this many times what the start and the loads supplied is a blow-up.
+  static constexpr double kDivergence = 1e3;
+
+  // Energy grown far beyond what was supplied: the scheme is unstable; stop now rather than at
+  // the NaN many steps later (or never, in a short run).
+  void diverged(const EnergyBalance& b, long long step, double time) {
+    if (!(b.supplied > 0 && b.stored > kDivergence * b.supplied))
+      return;
+    const auto at = largest(b.field);
+    std::ostringstream s;
+    s << "Error, the " << b.what << " diverged at step " << step << " (t = " << time
+      << " s): its stored energy " << b.stored_expression << " = " << b.stored << " J is more than "
+      << kDivergence << " times the energy supplied, " << b.supplied_expression << " = "
+      << b.supplied << " J. The largest |" << b.field << "|, " << at.value
+      << ", is at the point with global id " << at.gid << ", reference position (" << at.x[0]
+      << ", " << at.x[1] << (Dim == 3 ? ", " + std::to_string(at.x[2]) : std::string())
+      << ") m. The time step is likely beyond the stable one: use Solver->Automatic Time Step "
+         "or a smaller Solver->Time Step (and for the fluid Solver->Fluid Substeps = 0).";
+    throw CollectiveError(s.str());
+  }
+
   void energy(const EnergyBalance& b, long long steps_done, long long step, double time) {
     if (steps_done <= run_.energy_check_start ||
         !(b.error > run_.energy_tolerance * b.scale && b.scale > 0))
@@ -314,9 +348,66 @@ class StepChecks {
     if (run_.stop_on_energy_violation)
       throw CollectiveError("Error, " + s.str() + ".");
     long long& warnings = warnings_[b.what];
-    if (rank_ == 0 && (warnings < 5 || warnings % 1000 == 0))
+    if (rank_ == 0 && (warnings < kShownWarnings || warnings % 1000 == 0))
       out_ << "mupm: WARNING: " << s.str() << "\n";
+    if (rank_ == 0 && warnings + 1 == kShownWarnings)
+      out_ << "mupm: further " << b.what
+           << " energy-balance warnings are suppressed (every 1000th is shown; the count is "
+              "given at the end)\n";
     ++warnings;
+  }
+
+  // The point whose registry field `name` has the largest magnitude: value, global id, position.
+  struct Location {
+    double value = 0;
+    GlobalId gid = -1;
+    double x[3] = {0, 0, 0};
+  };
+  Location largest(const std::string& name) const {
+    const auto& pts = disc_.points;
+    std::vector<double> rows;
+    int nc = 1;
+    pts.for_each_field([&](const auto& view, const FieldSpec& s) {
+      using V = std::decay_t<decltype(view)>;
+      if constexpr (std::is_same_v<typename V::value_type, double>)
+        if (name == s.name) {
+          rows = io::owned_rows(view, pts.n_owned);
+          nc = s.ncomp;
+        }
+    });
+    struct {
+      double v;
+      int rank;
+    } best{-1.0, rank_}, all{};
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < pts.n_owned; ++i) {
+      double m = 0;
+      for (int c = 0; c < nc; ++c)
+        m +=
+            rows[i * std::size_t(nc) + std::size_t(c)] * rows[i * std::size_t(nc) + std::size_t(c)];
+      if (m > best.v) {
+        best.v = m;
+        at = i;
+      }
+    }
+    MPI_Allreduce(&best, &all, 1, MPI_DOUBLE_INT, MPI_MAXLOC, mpi_);
+    // The owner supplies the point; the sum over ranks hands it to everyone.
+    double buf[5] = {0, 0, 0, 0, 0};
+    if (all.rank == rank_ && pts.n_owned > 0) {
+      auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.gid);
+      auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
+      buf[0] = std::sqrt(best.v);
+      buf[1] = double(gid(at));
+      for (int k = 0; k < Dim; ++k)
+        buf[2 + k] = x(at, k);
+    }
+    MPI_Allreduce(MPI_IN_PLACE, buf, 5, MPI_DOUBLE, MPI_SUM, mpi_);
+    Location l;
+    l.value = buf[0];
+    l.gid = GlobalId(buf[1]);
+    for (int k = 0; k < 3; ++k)
+      l.x[k] = buf[2 + k];
+    return l;
   }
 
   void finite(long long step, double time) {
@@ -461,6 +552,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   }
 
   // ---------------------------------------------------------------- finish
+  checks.finish(step, time);
   if (run.checkpoint_at_end)
     checkpoint();
   RunSummary summary;

@@ -99,6 +99,27 @@ sed -e 's|value="{6, 40}"|value="{6, 12}"|' \
 grep -q 'value="5.11e3"' stiff_fluid.xml || fail "inputs/consolidation.xml changed: stiff_fluid.xml not derived"
 expect stiff_fluid 2 'substeps' 'mupm->Fluid->Hydraulic Conductivity' 'mupm->Fluid->Fluid Bulk Modulus'
 [[ -e stiff/fields_000000005.h5 ]] && fail "stiff_fluid: the run stepped"
+# A time step twice the stable one blows up (energy x100 a step): stopped at the step the stored
+# energy passes 1000 x what was supplied, naming the point (it once ran on to 1e116 m, exit 0).
+base '<ParameterList name="Regions"><ParameterList name="left">
+      <Parameter name="Min" type="Array(double)" value="{0, 0}"/>
+      <Parameter name="Max" type="Array(double)" value="{0.05, 0.1}"/></ParameterList></ParameterList>' \
+  '<Parameter name="Time Step" type="double" value="2e-5"/>
+   <Parameter name="Number of Steps" type="int" value="40"/>' | sed '$d' >diverging.xml
+cat >>diverging.xml <<'XML'
+  <ParameterList name="Initial Conditions"><ParameterList name="push">
+    <Parameter name="Field" type="string" value="Velocity"/>
+    <Parameter name="Region" type="string" value="left"/>
+    <Parameter name="Value" type="Array(double)" value="{0.1, 0}"/>
+  </ParameterList></ParameterList>
+</ParameterList>
+XML
+sed -i '/name="Number of Steps" type="int" value="2"/d' diverging.xml
+expect diverging 3 'solid diverged at step' 'global id' 'Automatic Time Step'
+# Energy warnings beyond the fifth are announced as suppressed and counted at the end.
+sed -e 's|value="2e-5"|value="1e-6"|' diverging.xml |
+  sed 's|<Parameter name="Time Step" type="double" value="1e-6"/>|&<Parameter name="Energy Tolerance" type="double" value="0"/><Parameter name="Energy Check Start" type="int" value="0"/>|' >warnings.xml
+expect warnings 0 'further solid energy-balance warnings are suppressed' 'solid energy-balance warnings in all'
 # A missing checkpoint stops both ranks cleanly (exit 3, no abort).
 base '' '<Parameter name="Restart From" type="string" value="nowhere/checkpoint.h5"/>' >no_checkpoint.xml
 expect no_checkpoint 3 'nowhere/checkpoint.h5'

@@ -11,7 +11,7 @@ export OMP_PROC_BIND=false OMP_PLACES=threads OMP_WAIT_POLICY=passive
 run() {
   local ranks=$1 threads=$2
   shift 2
-  OMP_NUM_THREADS=$threads timeout 300 "$MPIEXEC" --allow-run-as-root --oversubscribe \
+  OMP_NUM_THREADS=$threads timeout "${MUPM_RUN_TIMEOUT:-300}" "$MPIEXEC" --allow-run-as-root --oversubscribe \
     --bind-to none -np "$ranks" -x OMP_NUM_THREADS -x OMP_PROC_BIND -x OMP_PLACES -x OMP_WAIT_POLICY "$MUPM" "$@"
 }
 fail() {

@@ -115,7 +115,17 @@ class FluidSolver : public Module {
   // Energy balance (eqs 147-149, include/mupm/solvers/fluid_solver.hpp header).
   std::vector<EnergyBalance> energy_balances() const override {
     const auto e = energy();
-    return {{"fluid", "E_s - E_s0 + W_c + D - W_ext", std::abs(e.balance()), e.scale()}};
+    EnergyBalance b;
+    b.what = "fluid";
+    b.expression = "E_s - E_s0 + W_c + D - W_ext";
+    b.error = std::abs(e.balance());
+    b.scale = e.scale();
+    b.stored_expression = "E_s";
+    b.stored = std::abs(e.stored);
+    b.supplied_expression = "|E_s0| + |W_c| + |W_ext|";
+    b.supplied = std::abs(e.stored0) + std::abs(e.coupling_work) + std::abs(e.external_work);
+    b.field = "pore_pressure";
+    return {b};
   }
   const std::vector<double>& inflows() const { return inflow_; }
 

@@ -37,12 +37,17 @@ class GlobalRefs {
   std::vector<std::pair<std::string, double*>> refs_;
 };
 
-// One energy balance: |error| should stay below Solver->Energy Tolerance x scale.
+// One energy balance: |error| should stay below Solver->Energy Tolerance x scale. A stored
+// energy far beyond what was supplied means the scheme diverged (an unstable step).
 struct EnergyBalance {
   std::string what;        // "solid", "fluid"
   std::string expression;  // the balance as a formula, for the message
   double error = 0;        // the balance's value [J]
   double scale = 0;        // the largest of its terms [J]
+  std::string stored_expression, supplied_expression;
+  double stored = 0;    // energy held now [J]
+  double supplied = 0;  // all the energy there was at the start and came in since [J]
+  const char* field = "displacement";  // registry field whose largest value locates a blow-up
 };
 
 class Module {

@@ -107,8 +107,17 @@ class SolidSolver : public Mechanics {
   // Energy balance (eqs 137-140).
   std::vector<EnergyBalance> energy_balances() const override {
     const auto e = energy();
-    return {{"solid", "E_int + E_kin + D - W_ext - W_pore - E_0", std::abs(e.balance() - balance0_),
-             e.scale()}};
+    EnergyBalance b;
+    b.what = "solid";
+    b.expression = "E_int + E_kin + D - W_ext - W_pore - E_0";
+    b.error = std::abs(e.balance() - balance0_);
+    b.scale = e.scale();
+    b.stored_expression = "E_int + E_kin";
+    b.stored = std::abs(e.internal) + e.kinetic;
+    b.supplied_expression = "|E_0| + |W_ext| + |W_pore|";
+    b.supplied = std::abs(balance0_) + std::abs(e.external_work) + std::abs(e.pore_work);
+    b.field = "displacement";
+    return {b};
   }
 
   // Mixture density (eq 1) and micro-inertia (eq 13) from the current porosity and saturation.
