@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 namespace mupm {
@@ -537,8 +538,11 @@ void check_dimension_arrays(ParameterList& input) {
   for (auto it = cracks.begin(); it != cracks.end(); ++it) {
     ParameterList& c = cracks.sublist(cracks.name(it));
     if (dim == 2) {
-      get_array<double>(c, "Start", 2, "2D crack segment start in m");
-      get_array<double>(c, "End", 2, "2D crack segment end in m");
+      const auto a = get_array<double>(c, "Start", 2, "2D crack segment start in m");
+      const auto b = get_array<double>(c, "End", 2, "2D crack segment end in m");
+      if (a[0] == b[0] && a[1] == b[1])
+        throw InputError("Error, " + c.name() +
+                         ": Start and End are the same point; a pre-crack needs a length.");
       for (const char* k : {"Corner", "Edge 1", "Edge 2"})
         if (!c.get<Array<double>>(k).empty())
           throw InputError("Error, " + path_of(c, k) + " is for 3D cracks; use Start and End.");
@@ -678,11 +682,16 @@ bool strict_number(const std::string& token, bool integer) {
 }
 
 void check_numbers(const Teuchos::XMLObject& node, const std::string& path) {
+  std::set<std::string> seen;
   for (int k = 0; k < node.numChildren(); ++k) {
     const Teuchos::XMLObject& c = node.getChild(k);
     if (!c.hasAttribute("name"))
       continue;
     const std::string name = c.getAttribute("name");
+    // Teuchos keeps the last of two entries of one name without a word.
+    if (!seen.insert(name).second)
+      throw InputError("Error, " + path + "->" + name +
+                       " is given twice; give each parameter and sublist once.");
     if (c.getTag() == "ParameterList") {
       check_numbers(c, path + "->" + name);
       continue;
@@ -720,7 +729,13 @@ void check_numbers(const Teuchos::XMLObject& node, const std::string& path) {
 
 RCP<ParameterList> parse_input(const std::string& xml) {
   try {
-    check_numbers(Teuchos::StringInputSource(xml).getObject(), "mupm");
+    const auto root = Teuchos::StringInputSource(xml).getObject();
+    if (root.getTag() == "ParameterList" &&
+        (!root.hasAttribute("name") || root.getAttribute("name") != "mupm"))
+      throw InputError("Error, the input's root list is named '" +
+                       (root.hasAttribute("name") ? root.getAttribute("name") : std::string()) +
+                       "'; a mupm input is <ParameterList name=\"mupm\">.");
+    check_numbers(root, "mupm");
   } catch (const InputError&) {
     throw;
   } catch (const std::exception&) {

@@ -225,6 +225,51 @@ std::string too_stiff(const FluidParams& f, double dx, double stable_f, double i
   return s.str();
 }
 
+// Every boundary and initial condition acts on some point: a region that holds none makes the
+// condition a silent no-op.
+template <int Dim>
+void check_regions(const Model<Dim>& model, const Discretization<Dim>& disc, MPI_Comm mpi) {
+  const auto regions = io::owned_rows(disc.points.regions, disc.points.n_owned);
+  std::vector<long long> counts(model.grid.region_names.size(), 0);
+  for (std::uint32_t bits : regions)
+    for (std::size_t r = 0; r < counts.size(); ++r)
+      counts[r] += (bits >> r) & 1u;
+  MPI_Allreduce(MPI_IN_PLACE, counts.data(), int(counts.size()), MPI_LONG_LONG, MPI_SUM, mpi);
+  auto check = [&](const std::string& list, const std::string& name, std::uint32_t mask) {
+    for (std::size_t r = 0; r < counts.size(); ++r)
+      if (mask == (1u << r) && counts[r] == 0)
+        throw InputError("Error, mupm->" + list + "->" + name + "->Region = '" +
+                         model.grid.region_names[r] +
+                         "' holds no point: the condition would do nothing. Check the region's "
+                         "Min and Max against the body (points sit at cell centres) or its "
+                         "boundary layers.");
+  };
+  for (const auto& bc : model.boundary_conditions)
+    check("Boundary Conditions", bc.name, bc.region_mask);
+  for (const auto& ic : model.initial_conditions)
+    check("Initial Conditions", ic.name, ic.region_mask);
+}
+
+// Reads Solver->Restart From: its errors are input errors naming the parameter, and a restart
+// must have steps left to take.
+template <int Dim>
+void restart(const RunSettings& run, Discretization<Dim>& disc, long long& step, double& time,
+             std::vector<double>& history, const NamedGlobals& globals) {
+  const std::string where = "Error, mupm->Solver->Restart From = '" + run.restart_from + "': ";
+  try {
+    read_checkpoint(run.restart_from, disc, step, time, history, globals);
+  } catch (const CollectiveError& e) {
+    std::string msg = e.what();
+    if (msg.rfind("Error, ", 0) == 0)
+      msg = msg.substr(7);
+    throw InputError(where + msg);
+  }
+  if (step >= run.n_steps)
+    throw InputError(where + "the checkpoint is at step " + std::to_string(step) +
+                     ", and mupm->Solver->Number of Steps = " + std::to_string(run.n_steps) +
+                     " is not beyond it: the restart would take no step.");
+}
+
 // The time step and the fluid's substeps from the modules' stable-step estimates (Automatic
 // Time Step, Fluid Substeps = 0), with warnings where the given ones exceed them.
 template <int Dim>
@@ -474,6 +519,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   Points<Dim>& pts = disc.points;
   const long long n_bonds = report_discretization(disc, *comm, out);
   const long long n_global = disc.dist.n_global();
+  check_regions(model, disc, mpi);
   initial_state(model, pts);
   Assembly<Dim> ph = assemble(model, disc, mpi);
   long long step = 0;
@@ -481,7 +527,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   std::vector<double> history;
   const bool restarted = !run.restart_from.empty();
   if (restarted) {
-    read_checkpoint(run.restart_from, disc, step, time, history, ph.globals());
+    restart(run, disc, step, time, history, ph.globals());
     if (rank == 0)
       out << "mupm: restarted from " << run.restart_from << " at step " << step << "\n";
   }

@@ -155,8 +155,17 @@ TEST(Input, HorizonBelowSpacingIsRefused) {
   expect_error(xml(kOk + "<Parameter name=\"Horizon\" type=\"double\" value=\"0.001\"/>"),
                {"mupm->Discretization->Horizon =", "below the spacing 0.01 m"});
   // One spacing exactly still bonds the nearest neighbours.
-  auto pl = parse_input(xml(kOk + "<Parameter name=\"Horizon Factor\" type=\"double\" value=\"1\"/>"));
+  auto pl =
+      parse_input(xml(kOk + "<Parameter name=\"Horizon Factor\" type=\"double\" value=\"1\"/>"));
   EXPECT_NO_THROW(validate_input(*pl));
+}
+
+TEST(Input, ZeroLengthPreCrackIsRefused) {
+  expect_error(xml(kOk + "<ParameterList name=\"Pre-Cracks\"><ParameterList name=\"notch\">"
+                         "<Parameter name=\"Start\" type=\"Array(double)\" value=\"{0.05, 0.04}\"/>"
+                         "<Parameter name=\"End\" type=\"Array(double)\" value=\"{0.05, 0.04}\"/>"
+                         "</ParameterList></ParameterList>"),
+               {"mupm->Discretization->Pre-Cracks->notch", "needs a length"});
 }
 
 TEST(Input, NumbersAreReadStrictly) {
