@@ -1,8 +1,12 @@
 #include "mupm/io/csv.hpp"
 
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <locale>
+#include <sstream>
 #include <stdexcept>
 
 namespace mupm::io {
@@ -93,6 +97,39 @@ void CsvWriter::row(const std::vector<double>& values) {
   if (!out_) {
     throw std::runtime_error("mupm::io: CsvWriter('" + path_ + "'): write failed");
   }
+}
+
+void keep_rows_through(const std::string& path, double step) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    return;
+  std::stringstream all;
+  all << in.rdbuf();
+  in.close();
+  const std::string text = all.str();
+  std::string kept;
+  std::size_t pos = 0;
+  bool header = true;
+  while (pos < text.size()) {
+    const std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos)
+      break;  // an unfinished last line: the run stopped while writing it
+    const std::string line = text.substr(pos, end - pos + 1);
+    pos = end + 1;
+    if (!header && !(std::strtod(line.c_str(), nullptr) <= step))
+      break;  // rows are in step order: this one and all after it came after the restart step
+    header = false;
+    kept += line;
+  }
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << kept;
+    if (!out)
+      throw std::runtime_error("mupm::io: cannot rewrite '" + path +
+                               "' for the restart: " + std::strerror(errno));
+  }
+  std::filesystem::rename(tmp, path);
 }
 
 }  // namespace mupm::io

@@ -528,8 +528,10 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   const bool restarted = !run.restart_from.empty();
   if (restarted) {
     restart(run, disc, step, time, history, ph.globals());
-    if (rank == 0)
+    if (rank == 0) {
+      io::keep_rows_through(run.folder + "/time_series.csv", double(step));
       out << "mupm: restarted from " << run.restart_from << " at step " << step << "\n";
+    }
   }
   ph.damage->update();
   disc.dist.refresh(pts.double_fields(kGhosted));

@@ -147,6 +147,16 @@ run 2 1 done.xml >done.out 2>&1 || { cat done.out; fail "done.xml did not run"; 
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |
   sed -e 's|value="out"|value="again"|' -e 's|name="Number of Steps" type="int" value="2"|name="Number of Steps" type="int" value="1"|' >no_steps_left.xml
 expect no_steps_left 2 'the checkpoint is at step 2' 'mupm->Solver->Number of Steps = 1'
+# Restarting into the folder of a run that went past the checkpoint (a restart from an earlier
+# checkpoint, or a stop between a checkpoint and the next row) keeps one row per step.
+cp done/checkpoint.h5 step2.h5
+base '' '<Parameter name="Restart From" type="string" value="step2.h5"/>' |
+  sed -e 's|value="out"|value="done"|' -e 's|name="Number of Steps" type="int" value="2"|name="Number of Steps" type="int" value="5"|' >again.xml
+run 2 1 again.xml >again1.out 2>&1 || { cat again1.out; fail "again.xml (first restart) failed"; }
+run 2 1 again.xml >again2.out 2>&1 || { cat again2.out; fail "again.xml (second restart) failed"; }
+steps=$(tail -n +2 done/time_series.csv | cut -d, -f1 | tr '\n' ' ')
+[[ $steps == "0 1 2 3 4 5 " ]] || fail "restart into the same folder: time_series.csv steps are '$steps', expected 0 to 5 once each"
+echo "ok: restart rows (steps $steps)"
 # A valid input validates, and --print-defaults is XML that documents every parameter.
 base '' '' >valid.xml
 run 2 1 --validate valid.xml | grep -q "is valid" || fail "--validate of a valid input"

@@ -30,6 +30,11 @@ class CsvWriter {
   std::ofstream out_;
 };
 
+// For a restart at `step`: drops the rows of `path` whose first column (the step) is beyond it,
+// and an unfinished last line, so the continued run does not repeat rows. The file is replaced
+// whole once the kept rows are written. A missing file is left missing. Throws on I/O errors.
+void keep_rows_through(const std::string& path, double step);
+
 }  // namespace mupm::io
 
 #endif  // MUPM_CSV_HPP
