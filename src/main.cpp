@@ -8,6 +8,7 @@
 #include <iostream>
 #include <string>
 
+#include "mupm/core/stop.hpp"
 #include "mupm/input/input.hpp"
 #include "mupm/solvers/simulation.hpp"
 
@@ -20,7 +21,8 @@ const char* kUsage =
     "       mupm --help                 this text\n"
     "Parallel: mpirun -np R mupm INPUT.xml, with OMP_NUM_THREADS=T threads per rank\n"
     "(also OMP_PROC_BIND=spread OMP_PLACES=threads). Kokkos options (--kokkos-...) are accepted.\n"
-    "Exit codes: 0 success, 1 usage, 2 input error, 3 run-time error.\n";
+    "Exit codes: 0 success, 1 usage, 2 input error, 3 run-time error, 4 stopped by SIGTERM or\n"
+    "SIGINT after writing a checkpoint.\n";
 
 // Writes the input's verdict or the defaults without starting Kokkos, whose start-up chatter
 // (affinity warnings, its --help banner) would otherwise land in stdout before them.
@@ -93,10 +95,15 @@ int main(int argc, char* argv[]) {
   Tpetra::ScopeGuard scope(&argc, &argv);
   auto comm = Tpetra::getDefaultComm();
   const bool root = comm->getRank() == 0;
+  mupm::install_stop_handlers();
   try {
     auto input = mupm::read_input(*comm, path);
     mupm::validate_input(*input);
     mupm::run_simulation(comm, *input, std::cout);
+  } catch (const mupm::Interrupted& e) {
+    if (root)
+      std::cerr << "mupm: " << e.what() << "\n";
+    return mupm::kExitInterrupted;
   } catch (const mupm::InputError& e) {
     if (root)
       std::cerr << "mupm: input error in " << path << ":\n" << e.what() << "\n";

@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 
+#include "mupm/core/stop.hpp"
 #include "mupm/core/timers.hpp"
 #include "mupm/input/model.hpp"
 #include "mupm/io/checkpoint.hpp"
@@ -64,6 +65,8 @@ void prepare_folder(const Teuchos::Comm<int>& comm, const std::string& folder,
       ok = 0;
       why = ec.message();
     } else {
+      // A checkpoint being written when an earlier run was killed.
+      std::filesystem::remove(folder + "/checkpoint.h5.tmp", ec);
       try {
         Teuchos::writeParameterListToXmlFile(input, folder + "/input_resolved.xml");
       } catch (const std::exception& e) {
@@ -583,6 +586,16 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
       fields.write(step, time);
     if (run.checkpoint_interval > 0 && step % run.checkpoint_interval == 0 && step != last_step)
       checkpoint();
+    // SIGTERM/SIGINT on any rank: checkpoint this step on all of them and stop.
+    int stop = stop_requested() ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, mpi);
+    if (stop && step != last_step) {
+      write_series();
+      checkpoint();
+      throw Interrupted("stopped by a signal after step " + std::to_string(step) + " (t = " +
+                        std::to_string(time) + " s); checkpoint written to " + checkpoint_path +
+                        ": continue with Solver->Restart From = " + checkpoint_path + ".");
+    }
     if (rank == 0 &&
         (seconds_since(t_last_progress) >= run.progress_interval || step == last_step)) {
       t_last_progress = Clock::now();

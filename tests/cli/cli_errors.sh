@@ -157,6 +157,30 @@ run 2 1 again.xml >again2.out 2>&1 || { cat again2.out; fail "again.xml (second 
 steps=$(tail -n +2 done/time_series.csv | cut -d, -f1 | tr '\n' ' ')
 [[ $steps == "0 1 2 3 4 5 " ]] || fail "restart into the same folder: time_series.csv steps are '$steps', expected 0 to 5 once each"
 echo "ok: restart rows (steps $steps)"
+# SIGTERM to the ranks (a batch system's time limit): they finish the step, write a checkpoint
+# and exit with 4; a stale checkpoint.h5.tmp of a killed run is removed; the run continues from
+# the checkpoint.
+base '' '' | sed -e 's|value="out"|value="long"|' -e 's|name="Number of Steps" type="int" value="2"|name="Number of Steps" type="int" value="100000000"|' >sigterm.xml
+mkdir -p long && touch long/checkpoint.h5.tmp
+set +e
+run 2 1 sigterm.xml >sigterm.out 2>&1 &
+pid=$!
+for _ in $(seq 600); do
+  [[ -f long/time_series.csv && $(wc -l <long/time_series.csv) -ge 5 ]] && break
+  sleep 0.1
+done
+pkill -TERM -f "^$MUPM sigterm.xml"
+wait $pid
+got=$?
+set -e
+[[ $got == 4 ]] || { cat sigterm.out; fail "sigterm: exit code $got, expected 4"; }
+grep -qF "stopped by a signal after step" sigterm.out || { cat sigterm.out; fail "sigterm: no message"; }
+[[ -f long/checkpoint.h5 && ! -e long/checkpoint.h5.tmp ]] || fail "sigterm: no checkpoint, or a stale .tmp left"
+stopped=$("$PYTHON" -c "import h5py; print(h5py.File('long/checkpoint.h5').attrs['step'])")
+sed -e "s|value=\"100000000\"|value=\"$((stopped + 2))\"|" \
+    -e 's|<Parameter name="Number of Steps"|<Parameter name="Restart From" type="string" value="long/checkpoint.h5"/>&|' sigterm.xml >resume.xml
+run 2 1 resume.xml >resume.out 2>&1 || { cat resume.out; fail "sigterm: the restart from its checkpoint failed"; }
+echo "ok: sigterm (exit 4 at step $stopped, resumed)"
 # A valid input validates, and --print-defaults is XML that documents every parameter.
 base '' '' >valid.xml
 run 2 1 --validate valid.xml | grep -q "is valid" || fail "--validate of a valid input"

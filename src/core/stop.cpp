@@ -1,0 +1,23 @@
+#include "mupm/core/stop.hpp"
+
+#include <csignal>
+
+namespace mupm {
+
+namespace {
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop_signal(int) {
+  g_stop = 1;
+}
+}  // namespace
+
+void install_stop_handlers() {
+  std::signal(SIGTERM, on_stop_signal);
+  std::signal(SIGINT, on_stop_signal);
+}
+
+bool stop_requested() {
+  return g_stop != 0;
+}
+
+}  // namespace mupm
