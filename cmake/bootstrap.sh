@@ -35,15 +35,22 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" >bu
 rm -f build-configure.log
 cmake --build build -j"$jobs"
 
-export OMP_PROC_BIND=${OMP_PROC_BIND:-false} OMP_PLACES=${OMP_PLACES:-threads}
-mpirun_flags=(--bind-to none -x OMP_NUM_THREADS -x OMP_PROC_BIND -x OMP_PLACES)
-[[ $(id -u) == 0 ]] && mpirun_flags+=(--allow-run-as-root)
-
 case "$what" in
   quickstart)
+    # 2 ranks x T threads, each rank on T cores of its own (README, "Ranks and threads"); on a
+    # machine with fewer than 2 T cores the ranks share them unpinned.
+    export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+    if ((jobs >= 2 * OMP_NUM_THREADS)); then
+      export OMP_PROC_BIND=spread OMP_PLACES=cores
+      mpirun_flags=(--map-by "ppr:2:node:PE=$OMP_NUM_THREADS" --bind-to core)
+    else
+      export OMP_PROC_BIND=false OMP_PLACES=threads
+      mpirun_flags=(--oversubscribe --bind-to none)
+    fi
+    mpirun_flags+=(-x OMP_NUM_THREADS -x OMP_PROC_BIND -x OMP_PLACES)
+    [[ $(id -u) == 0 ]] && mpirun_flags+=(--allow-run-as-root)
     mkdir -p build/quickstart && cd build/quickstart
-    OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} mpirun "${mpirun_flags[@]}" -np 2 ../mupm \
-      "$root/inputs/quickstart.xml"
+    mpirun "${mpirun_flags[@]}" -np 2 ../mupm "$root/inputs/quickstart.xml"
     echo "Output in $root/build/quickstart/output: open fields.xmf in ParaView (Xdmf reader)."
     ;;
   test)

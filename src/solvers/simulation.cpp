@@ -1,7 +1,11 @@
 #include "mupm/solvers/simulation.hpp"
 
+#include <sched.h>
+#include <unistd.h>
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
+
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -106,6 +110,56 @@ GlobalId non_finite_point(const Points<Dim>& p) {
       },
       Kokkos::Max<GlobalId>(g));
   return g;
+}
+
+// Warns (rank 0) when the ranks of a node and their threads do not sit on cores of their own:
+// threads x ranks beyond the node's cores, or OpenMP threads pinned (OMP_PROC_BIND not false)
+// while the ranks' affinity masks overlap, which puts the threads of every rank on the same
+// first cores (measured: the quick start 4-5x slower on 2 ranks).
+void warn_placement(MPI_Comm comm, int threads, std::ostream& out) {
+  MPI_Comm node;
+  MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
+  int node_rank = 0, node_size = 1;
+  MPI_Comm_rank(node, &node_rank);
+  MPI_Comm_size(node, &node_size);
+  cpu_set_t mask;
+  CPU_ZERO(&mask);
+  sched_getaffinity(0, sizeof mask, &mask);
+  std::vector<cpu_set_t> masks(static_cast<std::size_t>(node_size));
+  MPI_Allgather(&mask, int(sizeof mask), MPI_BYTE, masks.data(), int(sizeof mask), MPI_BYTE, node);
+  MPI_Comm_free(&node);
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  const char* bind = std::getenv("OMP_PROC_BIND");
+  std::string b = bind ? bind : "";
+  for (auto& c : b)
+    c = char(std::tolower(static_cast<unsigned char>(c)));
+  const bool pinned = !b.empty() && b != "false";
+  int shared = 0;
+  for (int i = 0; i < node_size && !shared; ++i)
+    for (int j = i + 1; j < node_size && !shared; ++j) {
+      cpu_set_t both;
+      CPU_AND(&both, &masks[std::size_t(i)], &masks[std::size_t(j)]);
+      shared = CPU_COUNT(&both) > 0;
+    }
+  int flags[2] = {long(node_size) * threads > cores ? 1 : 0, pinned && shared ? 1 : 0};
+  MPI_Allreduce(MPI_IN_PLACE, flags, 2, MPI_INT, MPI_MAX, comm);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank != 0)
+    return;
+  const std::string line =
+      "OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=cores mpirun --map-by ppr:R:node:PE=T "
+      "--bind-to core -x OMP_NUM_THREADS -x OMP_PROC_BIND -x OMP_PLACES mupm input.xml (R ranks "
+      "x T threads a node)";
+  if (flags[0])
+    out << "mupm: WARNING: " << node_size << " rank(s) x " << threads << " thread(s) on a node of "
+        << cores
+        << " cores: they take turns on the cores and every step waits for the slowest. Launch "
+        << line << ".\n";
+  if (flags[1])
+    out << "mupm: WARNING: ranks on one node share cores while OMP_PROC_BIND = " << bind
+        << " pins their threads: the threads of every rank sit on the same first cores. Launch "
+        << line << ", or set OMP_PROC_BIND=false.\n";
 }
 
 // The physics modules of a run and the step sequence over them (Algorithm 1).
@@ -517,6 +571,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   const RunSettings& run = model.run;
   const bool timers_on = run.kernel_timers && timers::enable();
   prepare_folder(*comm, run.folder, input);
+  warn_placement(mpi, int(ExecSpace().concurrency()), out);
 
   Discretization<Dim> disc = discretize(comm, model.grid);
   Points<Dim>& pts = disc.points;

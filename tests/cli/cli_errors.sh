@@ -183,6 +183,11 @@ run 2 1 resume.xml >resume.out 2>&1 || { cat resume.out; fail "sigterm: the rest
 echo "ok: sigterm (exit 4 at step $stopped, resumed)"
 # A valid input validates, and --print-defaults is XML that documents every parameter.
 base '' '' >valid.xml
+# Threads pinned (OMP_PROC_BIND=spread) while the ranks' masks overlap (--bind-to none): warned.
+OMP_PROC_BIND=spread run 2 1 valid.xml >pinned.out 2>&1 || { cat pinned.out; fail "pinned: run failed"; }
+grep -qF "WARNING: ranks on one node share cores while OMP_PROC_BIND = spread" pinned.out ||
+  { cat pinned.out; fail "pinned: no placement warning"; }
+echo "ok: placement warning"
 run 2 1 --validate valid.xml | grep -q "is valid" || fail "--validate of a valid input"
 # stdout of --print-defaults, --help and --validate holds their output alone, whatever the OpenMP
 # environment (Kokkos warned about OMP_PROC_BIND into stdout, making defaults.xml invalid XML).
