@@ -42,8 +42,12 @@ int without_kokkos(const std::string& mode, const std::string& path, int argc, c
       try {
         auto input = mupm::read_input(*comm, path);
         mupm::validate_input(*input);
+        const auto m = mupm::check_memory(*comm, *input);
         if (root)
-          std::cout << "mupm: " << path << " is valid\n";
+          std::cout << "mupm: " << path << " is valid; it needs about "
+                    << m.bytes_per_rank / (1 << 20) << " MiB per rank on " << comm->getSize()
+                    << " rank(s) (" << m.available_per_rank / (1 << 20)
+                    << " MiB available per rank)\n";
       } catch (const mupm::InputError& e) {
         if (root)
           std::cerr << "mupm: input error in " << path << ":\n" << e.what() << "\n";
@@ -99,6 +103,7 @@ int main(int argc, char* argv[]) {
   try {
     auto input = mupm::read_input(*comm, path);
     mupm::validate_input(*input);
+    mupm::check_memory(*comm, *input);
     mupm::run_simulation(comm, *input, std::cout);
   } catch (const mupm::Interrupted& e) {
     if (root)

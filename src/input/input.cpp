@@ -1,14 +1,17 @@
 #include "mupm/input/input.hpp"
 
+#include "mupm/data/bonds.hpp"
 #include "mupm/data/points.hpp"
 #include "mupm/input/options.hpp"
 
 #include <Teuchos_Array.hpp>
 #include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
 #include <Teuchos_StandardParameterEntryValidators.hpp>
 #include <Teuchos_StringInputSource.hpp>
 #include <Teuchos_XMLObject.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -788,6 +791,84 @@ void validate_input(ParameterList& input) {
                      "->Discretization is missing.");
   validate_level(input, *valid_parameters());
   check_dimension_arrays(input);
+}
+
+namespace {
+
+template <int Dim>
+MemoryNeed memory_need_of(const ParameterList& input, int ranks) {
+  const GridSpec<Dim> g = grid_from_input<Dim>(input);
+  MemoryNeed m;
+  m.points = double(g.n_global());
+  // Bonds per point: the lattice offsets within the horizon.
+  const int r = int(g.horizon / g.dx);
+  long long family = 0;
+  for (int i = -r; i <= r; ++i)
+    for (int j = -r; j <= r; ++j)
+      for (int k = (Dim == 3 ? -r : 0); k <= (Dim == 3 ? r : 0); ++k) {
+        const double d2 = double(i * i + j * j + k * k) * g.dx * g.dx;
+        family += (d2 > 0 && d2 <= g.horizon * g.horizon * (1 + 1e-12)) ? 1 : 0;
+      }
+  m.bonds_per_point = double(family);
+  // A rank's part: a box of n points with a halo of r rows of ghosts.
+  const double n = std::ceil(m.points / ranks);
+  const double side = std::pow(n, 1.0 / Dim);
+  const double ghosts = std::min(std::pow(side + 2 * r, Dim) - n, m.points - n);
+  // Per point: the registry's fields, plus solver state, shape tensors and ghost-exchange buffers
+  // (SolidState, FluidState, solver arrays, two MultiVectors of the widest refresh): 512 B in 2D,
+  // 1 KiB in 3D. Per bond: the bond registry, plus the sort keys of the neighbour build.
+  const double per_point = double(Points<Dim>::bytes_per_point()) + (Dim == 2 ? 512 : 1024);
+  const double per_bond = double(Bonds::bytes_per_bond()) + sizeof(GlobalId);
+  m.bytes_per_rank = (n + ghosts) * per_point + n * m.bonds_per_point * per_bond;
+  return m;
+}
+
+double mem_available_bytes() {
+  std::ifstream f("/proc/meminfo");
+  std::string key;
+  double kb = 0;
+  while (f >> key >> kb) {
+    if (key == "MemAvailable:")
+      return kb * 1024;
+    f.ignore(256, '\n');
+  }
+  return 0;  // unknown
+}
+
+}  // namespace
+
+MemoryNeed memory_need(const Teuchos::Comm<int>& comm, const ParameterList& input) {
+  MemoryNeed m = input_dimension(input) == 2 ? memory_need_of<2>(input, comm.getSize())
+                                             : memory_need_of<3>(input, comm.getSize());
+  MPI_Comm raw = MPI_COMM_SELF;
+  if (const auto* mc = dynamic_cast<const Teuchos::MpiComm<int>*>(&comm))
+    raw = (*mc->getRawMpiComm())();
+  MPI_Comm node;
+  MPI_Comm_split_type(raw, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
+  int on_node = 1;
+  MPI_Comm_size(node, &on_node);
+  MPI_Comm_free(&node);
+  double avail = mem_available_bytes() / on_node;
+  MPI_Allreduce(MPI_IN_PLACE, &avail, 1, MPI_DOUBLE, MPI_MIN, raw);
+  m.available_per_rank = avail;
+  return m;
+}
+
+MemoryNeed check_memory(const Teuchos::Comm<int>& comm, const ParameterList& input) {
+  const MemoryNeed m = memory_need(comm, input);
+  if (m.available_per_rank > 0 && m.bytes_per_rank > m.available_per_rank) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "Error, the discretization (mupm->Discretization->Counts or Extents, Spacing, Horizon) "
+         "needs about "
+      << m.bytes_per_rank / (1 << 30) << " GiB per rank (" << m.points << " points, "
+      << m.bonds_per_point << " bonds each, " << comm.getSize() << " rank(s)): more than the "
+      << m.available_per_rank / (1 << 30)
+      << " GiB available per rank (MemAvailable over the ranks of a node). Use more nodes or a "
+         "coarser Spacing.";
+    throw InputError(s.str());
+  }
+  return m;
 }
 
 int input_dimension(const ParameterList& input) {

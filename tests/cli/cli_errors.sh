@@ -195,7 +195,18 @@ env -u OMP_PROC_BIND -u OMP_PLACES "$MUPM" --print-defaults >defaults.xml
 env -u OMP_PROC_BIND "$MUPM" --help >help.out
 head -n 1 help.out | grep -q "^usage: mupm" || { cat help.out; fail "--help: stdout does not start with the usage"; }
 env -u OMP_PROC_BIND "$MUPM" --validate valid.xml >validate.out
-[[ $(cat validate.out) == "mupm: valid.xml is valid" ]] || { cat validate.out; fail "--validate: stdout is not the verdict alone"; }
+[[ $(wc -l <validate.out) == 1 ]] && grep -q "^mupm: valid.xml is valid; it needs about .* MiB per rank" validate.out ||
+  { cat validate.out; fail "--validate: stdout is not the verdict alone"; }
+# A grid beyond the machine's memory is refused before anything is allocated, by the run and by
+# --validate (it once grew until the kernel killed it, or ended in std::bad_alloc).
+base '' '' | sed 's|value="{20, 10}"|value="{20000, 20000}"|' >huge.xml
+expect huge 2 'GiB per rank' 'GiB available per rank' 'mupm->Discretization->Counts'
+set +e
+run 2 1 --validate huge.xml >huge_validate.out 2>&1
+got=$?
+set -e
+[[ $got == 2 ]] && grep -q "GiB available per rank" huge_validate.out || { cat huge_validate.out; fail "huge: --validate exit $got"; }
+echo "ok: huge (refused by the run and by --validate)"
 "$PYTHON" - defaults.xml <<'PY'
 import sys, xml.etree.ElementTree as ET
 root = ET.parse(sys.argv[1]).getroot()

@@ -55,6 +55,17 @@ std::vector<InitialCondition> initial_conditions_from_input(const Teuchos::Param
 
 std::vector<BoundaryCondition> boundary_conditions_from_input(const Teuchos::ParameterList& input);
 
+// The memory a run of this input needs per rank (points, bonds, solver state, ghost buffers;
+// an estimate within tens of percent) and what the node offers per rank (MemAvailable / ranks
+// on the node, the smallest over nodes). Collective over comm.
+struct MemoryNeed {
+  double points = 0, bonds_per_point = 0;
+  double bytes_per_rank = 0, available_per_rank = 0;
+};
+MemoryNeed memory_need(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& input);
+// Throws InputError (on every rank) when the need exceeds what is available.
+MemoryNeed check_memory(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& input);
+
 // Names of the point fields that can be written (Output->Fields).
 const std::vector<std::string>& output_field_names();
 
