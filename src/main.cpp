@@ -42,6 +42,7 @@ int without_kokkos(const std::string& mode, const std::string& path, int argc, c
       try {
         auto input = mupm::read_input(*comm, path);
         mupm::validate_input(*input);
+        mupm::check_files(*comm, *input);
         const auto m = mupm::check_memory(*comm, *input);
         if (root)
           std::cout << "mupm: " << path << " is valid; it needs about "
@@ -103,6 +104,7 @@ int main(int argc, char* argv[]) {
   try {
     auto input = mupm::read_input(*comm, path);
     mupm::validate_input(*input);
+    mupm::check_files(*comm, *input);
     mupm::check_memory(*comm, *input);
     mupm::run_simulation(comm, *input, std::cout);
   } catch (const mupm::Interrupted& e) {

@@ -4,6 +4,7 @@
 #include "mupm/data/points.hpp"
 #include "mupm/input/options.hpp"
 
+#include <unistd.h>
 #include <Teuchos_Array.hpp>
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_DefaultMpiComm.hpp>
@@ -12,9 +13,12 @@
 #include <Teuchos_XMLObject.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
 #include <algorithm>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -763,7 +767,8 @@ RCP<ParameterList> read_input(const Teuchos::Comm<int>& comm, const std::string&
   int ok = 1;
   if (comm.getRank() == 0) {
     std::ifstream f(path);
-    if (!f) {
+    std::error_code ec;
+    if (!f || std::filesystem::is_directory(path, ec)) {
       ok = 0;
     } else {
       std::ostringstream s;
@@ -869,6 +874,46 @@ MemoryNeed check_memory(const Teuchos::Comm<int>& comm, const ParameterList& inp
     throw InputError(s.str());
   }
   return m;
+}
+
+void check_files(const Teuchos::Comm<int>& comm, const ParameterList& input) {
+  std::string why;
+  if (comm.getRank() == 0) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const std::string restart = input.sublist("Solver").get<std::string>("Restart From");
+    if (!restart.empty()) {
+      std::ifstream f(restart, std::ios::binary);
+      char sig[8] = {};
+      const char hdf5[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+      if (fs::is_directory(restart, ec))
+        why = "Error, mupm->Solver->Restart From = '" + restart +
+              "' is a directory; give the checkpoint file, e.g. '" + restart + "/checkpoint.h5'.";
+      else if (!f)
+        why = "Error, mupm->Solver->Restart From = '" + restart +
+              "': no such file (or it cannot be read).";
+      else if (!f.read(sig, 8) || !std::equal(sig, sig + 8, hdf5))
+        why = "Error, mupm->Solver->Restart From = '" + restart +
+              "' is not an HDF5 file; give a checkpoint.h5 a mupm run wrote.";
+    }
+    // The output folder, or the nearest existing folder above it, must be writable.
+    const std::string folder = input.sublist("Output").get<std::string>("Folder");
+    fs::path p = fs::absolute(folder, ec);
+    while (!p.empty() && !fs::exists(p, ec) && p != p.parent_path())
+      p = p.parent_path();
+    if (why.empty() && fs::exists(folder, ec) && !fs::is_directory(folder, ec))
+      why = "Error, mupm->Output->Folder = '" + folder + "' is a file, not a folder.";
+    else if (why.empty() && access(p.c_str(), W_OK | X_OK) != 0)
+      why = "Error, mupm->Output->Folder = '" + folder + "': '" + p.string() +
+            "' is not writable (" + std::strerror(errno) + ").";
+  }
+  long long n = static_cast<long long>(why.size());
+  Teuchos::broadcast(comm, 0, &n);
+  why.resize(static_cast<std::size_t>(n));
+  if (n > 0) {
+    Teuchos::broadcast(comm, 0, static_cast<int>(n), &why[0]);
+    throw InputError(why);
+  }
 }
 
 int input_dimension(const ParameterList& input) {

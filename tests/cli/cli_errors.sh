@@ -123,6 +123,27 @@ expect warnings 0 'further solid energy-balance warnings are suppressed' 'solid 
 base '' '<Parameter name="Restart From" type="string" value="nowhere/checkpoint.h5"/>' >no_checkpoint.xml
 expect no_checkpoint 2 "mupm->Solver->Restart From = 'nowhere/checkpoint.h5'"
 grep -q "MPI_ABORT" no_checkpoint.out && fail "no_checkpoint: aborted instead of stopping cleanly"
+# Files the input names are checked before any work, in one line each, by the run and by
+# --validate: a directory as the input or as the restart file, a file that is not HDF5.
+mkdir -p adir
+expect_dir() {  # expect_dir NAME PATTERN ARGS...: exit 2 and one line of error
+  local name=$1 pattern=$2
+  shift 2
+  set +e
+  run 2 1 "$@" >"$name.out" 2>"$name.err"
+  local got=$?
+  set -e
+  [[ $got == 2 ]] && grep -qF -- "$pattern" "$name.err" || { cat "$name.err"; fail "$name: exit $got"; }
+  grep -q "HDF5-DIAG\|MPI_ERR\|packages/" "$name.err" && { cat "$name.err"; fail "$name: library noise"; }
+  echo "ok: $name"
+}
+expect_dir input_dir "cannot read the input file 'adir'" adir
+base '' '<Parameter name="Restart From" type="string" value="adir"/>' >restart_dir.xml
+expect_dir restart_dir "mupm->Solver->Restart From = 'adir' is a directory" restart_dir.xml
+expect_dir restart_dir_validate "mupm->Solver->Restart From = 'adir' is a directory" --validate restart_dir.xml
+base '' '<Parameter name="Restart From" type="string" value="valid.xml"/>' >restart_xml.xml
+base '' '' >valid.xml
+expect_dir restart_not_hdf5 "is not an HDF5 file" --validate restart_xml.xml
 # Silent no-ops are refused: a parameter given twice (Teuchos keeps the last), a root list not
 # named mupm, a condition on a region without points, a restart with no step left to take.
 base '' '<Parameter name="Time Step" type="double" value="1e-6"/><Parameter name="Time Step" type="double" value="2e-6"/>' >twice.xml

@@ -66,6 +66,10 @@ MemoryNeed memory_need(const Teuchos::Comm<int>& comm, const Teuchos::ParameterL
 // Throws InputError (on every rank) when the need exceeds what is available.
 MemoryNeed check_memory(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& input);
 
+// The files the input names, before any work: Solver->Restart From an HDF5 file, Output->Folder
+// writable (or creatable). Throws InputError on every rank. Collective.
+void check_files(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& input);
+
 // Names of the point fields that can be written (Output->Fields).
 const std::vector<std::string>& output_field_names();
 
