@@ -10,6 +10,8 @@
 
 #include "mupm/core/stop.hpp"
 #include "mupm/input/input.hpp"
+#include "mupm/io/checkpoint.hpp"
+#include "mupm/io/point_rows.hpp"
 #include "mupm/solvers/simulation.hpp"
 
 namespace {
@@ -23,6 +25,31 @@ const char* kUsage =
     "(also OMP_PROC_BIND=spread OMP_PLACES=threads). Kokkos options (--kokkos-...) are accepted.\n"
     "Exit codes: 0 success, 1 usage, 2 input error, 3 run-time error, 4 stopped by SIGTERM or\n"
     "SIGINT after writing a checkpoint.\n";
+
+// --validate: the restart file matches the input's grid (the run checks it when it reads it).
+void check_restart_file(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& input) {
+  const std::string path = input.sublist("Solver").get<std::string>("Restart From");
+  if (path.empty())
+    return;
+  const int dim = mupm::input_dimension(input);
+  long long n = 0;
+  double dx = 0, horizon = 0;
+  if (dim == 2) {
+    const auto g = mupm::grid_from_input<2>(input);
+    n = g.n_global(), dx = g.dx, horizon = g.horizon;
+  } else {
+    const auto g = mupm::grid_from_input<3>(input);
+    n = g.n_global(), dx = g.dx, horizon = g.horizon;
+  }
+  try {
+    mupm::check_checkpoint(mupm::io::raw(comm), path, dim, n, dx, horizon);
+  } catch (const mupm::CollectiveError& e) {
+    std::string msg = e.what();
+    if (msg.rfind("Error, ", 0) == 0)
+      msg = msg.substr(7);
+    throw mupm::InputError("Error, mupm->Solver->Restart From = '" + path + "': " + msg);
+  }
+}
 
 // Writes the input's verdict or the defaults without starting Kokkos, whose start-up chatter
 // (affinity warnings, its --help banner) would otherwise land in stdout before them.
@@ -43,6 +70,7 @@ int without_kokkos(const std::string& mode, const std::string& path, int argc, c
         auto input = mupm::read_input(*comm, path);
         mupm::validate_input(*input);
         mupm::check_files(*comm, *input);
+        check_restart_file(*comm, *input);
         const auto m = mupm::check_memory(*comm, *input);
         if (root)
           std::cout << "mupm: " << path << " is valid; it needs about "

@@ -100,6 +100,48 @@ std::vector<GlobalId> owned_gids(const GlobalIds& gid, std::size_t n_owned) {
 
 }  // namespace
 
+namespace {
+
+void check_header(const io::PointFile& file, const std::string& path, int dim, long long n_global,
+                  double dx, double horizon) {
+  const std::string where = "Error, the checkpoint '" + path + "' ";
+  const long long version = file.has_attribute("mupm_checkpoint_version")
+                                ? file.read_attribute_int("mupm_checkpoint_version")
+                                : -1;
+  if (version != kCheckpointVersion)
+    throw CollectiveError(
+        where +
+        (version < 0 ? std::string("is not a mupm checkpoint (no mupm_checkpoint_version)")
+                     : "has layout version " + std::to_string(version)) +
+        "; this mupm reads version " + std::to_string(kCheckpointVersion) +
+        ". Restart with the mupm that wrote it, or start the run again.");
+  auto mismatch = [&](const std::string& what, const std::string& found,
+                      const std::string& expected) {
+    throw CollectiveError(where + "does not match this input: " + what + " is " + found +
+                          " there and " + expected + " here.");
+  };
+  if (file.read_attribute_int("dimension") != dim)
+    mismatch("the dimension", std::to_string(file.read_attribute_int("dimension")),
+             std::to_string(dim));
+  if (file.read_attribute_int("n_global") != n_global)
+    mismatch("the number of points", std::to_string(file.read_attribute_int("n_global")),
+             std::to_string(n_global));
+  if (file.read_attribute_double("spacing") != dx ||
+      file.read_attribute_double("horizon") != horizon)
+    mismatch("the spacing/horizon",
+             std::to_string(file.read_attribute_double("spacing")) + "/" +
+                 std::to_string(file.read_attribute_double("horizon")),
+             std::to_string(dx) + "/" + std::to_string(horizon));
+}
+
+}  // namespace
+
+void check_checkpoint(MPI_Comm comm, const std::string& path, int dim, long long n_global,
+                      double dx, double horizon) {
+  auto file = io::PointFile::open(comm, path);
+  check_header(file, path, dim, n_global, dx, horizon);
+}
+
 template <int Dim>
 void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, long long step,
                       double time, const std::vector<double>& output_history,
@@ -152,33 +194,7 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
   const auto gids = owned_gids(disc.points.gid, n);
   auto file = io::PointFile::open(comm, path);
   const std::string where = "Error, the checkpoint '" + path + "' ";
-  const long long version = file.has_attribute("mupm_checkpoint_version")
-                                ? file.read_attribute_int("mupm_checkpoint_version")
-                                : -1;
-  if (version != kCheckpointVersion)
-    throw CollectiveError(
-        where +
-        (version < 0 ? std::string("is not a mupm checkpoint (no mupm_checkpoint_version)")
-                     : "has layout version " + std::to_string(version)) +
-        "; this mupm reads version " + std::to_string(kCheckpointVersion) +
-        ". Restart with the mupm that wrote it, or start the run again.");
-  auto mismatch = [&](const std::string& what, const std::string& found,
-                      const std::string& expected) {
-    throw CollectiveError(where + "does not match this input: " + what + " is " + found +
-                          " there and " + expected + " here.");
-  };
-  if (file.read_attribute_int("dimension") != Dim)
-    mismatch("the dimension", std::to_string(file.read_attribute_int("dimension")),
-             std::to_string(Dim));
-  if (file.read_attribute_int("n_global") != disc.dist.n_global())
-    mismatch("the number of points", std::to_string(file.read_attribute_int("n_global")),
-             std::to_string(disc.dist.n_global()));
-  if (file.read_attribute_double("spacing") != disc.grid.dx ||
-      file.read_attribute_double("horizon") != disc.grid.horizon)
-    mismatch("the spacing/horizon",
-             std::to_string(file.read_attribute_double("spacing")) + "/" +
-                 std::to_string(file.read_attribute_double("horizon")),
-             std::to_string(disc.grid.dx) + "/" + std::to_string(disc.grid.horizon));
+  check_header(file, path, Dim, disc.dist.n_global(), disc.grid.dx, disc.grid.horizon);
   step = file.read_attribute_int("step");
   time = file.read_attribute_double("time");
   output_history = file.read_global("output_history");

@@ -168,6 +168,10 @@ run 2 1 done.xml >done.out 2>&1 || { cat done.out; fail "done.xml did not run"; 
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |
   sed -e 's|value="out"|value="again"|' -e 's|name="Number of Steps" type="int" value="2"|name="Number of Steps" type="int" value="1"|' >no_steps_left.xml
 expect no_steps_left 2 'the checkpoint is at step 2' 'mupm->Solver->Number of Steps = 1'
+# --validate finds a checkpoint of another grid, as the run would.
+base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |
+  sed 's|value="{20, 10}"|value="{20, 11}"|' >other_grid.xml
+expect_dir other_grid_validate "does not match this input: the number of points is 200 there and 220 here" --validate other_grid.xml
 # Restarting into the folder of a run that went past the checkpoint (a restart from an earlier
 # checkpoint, or a stop between a checkpoint and the next row) keeps one row per step.
 cp done/checkpoint.h5 step2.h5

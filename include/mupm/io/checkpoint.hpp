@@ -25,6 +25,11 @@ template <int Dim>
 void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, long long step,
                       double time, const std::vector<double>& output_history,
                       const NamedGlobals& globals = {});
+// Collective check that `path` is a checkpoint of this layout version for a grid of this
+// dimension, number of points, spacing and horizon (what --validate can tell without the run).
+void check_checkpoint(MPI_Comm comm, const std::string& path, int dim, long long n_global,
+                      double dx, double horizon);
+
 // Collective restore of the step, the time, the output history, the point and bond fields and
 // the named globals; then the shape tensors of the restored bonds. Throws CollectiveError (on
 // every rank) when the checkpoint's version or discretization does not match, or a global is
