@@ -645,7 +645,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     int stop = stop_requested() ? 1 : 0;
     MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, mpi);
     if (stop && step != last_step) {
-      write_series();
+      if (step % run.series_interval != 0)
+        write_series();  // the row of the step the restart continues from
       checkpoint();
       throw Interrupted("stopped by a signal after step " + std::to_string(step) + " (t = " +
                         std::to_string(time) + " s); checkpoint written to " + checkpoint_path +

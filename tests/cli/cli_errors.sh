@@ -205,6 +205,8 @@ stopped=$("$PYTHON" -c "import h5py; print(h5py.File('long/checkpoint.h5').attrs
 sed -e "s|value=\"100000000\"|value=\"$((stopped + 2))\"|" \
     -e 's|<Parameter name="Number of Steps"|<Parameter name="Restart From" type="string" value="long/checkpoint.h5"/>&|' sigterm.xml >resume.xml
 run 2 1 resume.xml >resume.out 2>&1 || { cat resume.out; fail "sigterm: the restart from its checkpoint failed"; }
+rows=$(tail -n +2 long/time_series.csv | cut -d, -f1 | sort -n | uniq -d | wc -l)
+[[ $rows == 0 ]] || fail "sigterm: time_series.csv repeats $rows step(s)"
 echo "ok: sigterm (exit 4 at step $stopped, resumed)"
 # A valid input validates, and --print-defaults is XML that documents every parameter.
 base '' '' >valid.xml
