@@ -44,10 +44,7 @@ void check_restart_file(const Teuchos::Comm<int>& comm, const Teuchos::Parameter
   try {
     mupm::check_checkpoint(mupm::io::raw(comm), path, dim, n, dx, horizon);
   } catch (const mupm::CollectiveError& e) {
-    std::string msg = e.what();
-    if (msg.rfind("Error, ", 0) == 0)
-      msg = msg.substr(7);
-    throw mupm::InputError("Error, mupm->Solver->Restart From = '" + path + "': " + msg);
+    throw mupm::InputError(mupm::restart_from_error(path, e));
   }
 }
 

@@ -93,11 +93,6 @@ void for_each_checkpointed(Registry& r, F&& f) {
   });
 }
 
-std::vector<GlobalId> owned_gids(const GlobalIds& gid, std::size_t n_owned) {
-  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), gid);
-  return std::vector<GlobalId>(h.data(), h.data() + n_owned);
-}
-
 }  // namespace
 
 namespace {
@@ -142,6 +137,13 @@ void check_checkpoint(MPI_Comm comm, const std::string& path, int dim, long long
   check_header(file, path, dim, n_global, dx, horizon);
 }
 
+std::string restart_from_error(const std::string& path, const std::exception& e) {
+  std::string msg = e.what();
+  if (msg.rfind("Error, ", 0) == 0)
+    msg = msg.substr(7);
+  return "Error, mupm->Solver->Restart From = '" + path + "': " + msg;
+}
+
 template <int Dim>
 void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, long long step,
                       double time, const std::vector<double>& output_history,
@@ -150,7 +152,7 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
   const MPI_Comm comm = io::raw(*disc.dist.comm());
   const std::size_t n = disc.points.n_owned;
   const GlobalId n_global = disc.dist.n_global();
-  const auto gids = owned_gids(disc.points.gid, n);
+  const auto gids = io::owned_rows(disc.points.gid, n);
   const std::string tmp = path + ".tmp";
   {
     auto file = io::PointFile::create(comm, tmp);
@@ -191,7 +193,7 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
   ScopedRegion region("mupm::Output::restart");
   const MPI_Comm comm = io::raw(*disc.dist.comm());
   const std::size_t n = disc.points.n_owned;
-  const auto gids = owned_gids(disc.points.gid, n);
+  const auto gids = io::owned_rows(disc.points.gid, n);
   auto file = io::PointFile::open(comm, path);
   const std::string where = "Error, the checkpoint '" + path + "' ";
   check_header(file, path, Dim, disc.dist.n_global(), disc.grid.dx, disc.grid.horizon);

@@ -11,11 +11,6 @@ namespace mupm {
 
 namespace {
 
-std::vector<GlobalId> owned_gids(const GlobalIds& gid, std::size_t n_owned) {
-  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), gid);
-  return std::vector<GlobalId>(h.data(), h.data() + n_owned);
-}
-
 std::string fields_file(long long step) {
   char name[64];
   std::snprintf(name, sizeof name, "fields_%09lld.h5", step);
@@ -30,7 +25,7 @@ FieldOutput<Dim>::FieldOutput(const std::string& folder, const Discretization<Di
     : folder_(folder), disc_(disc), fields_(fields), history_(std::move(history)) {
   const MPI_Comm comm = io::raw(*disc.dist.comm());
   const std::size_t n = disc.points.n_owned;
-  const auto gids = owned_gids(disc.points.gid, n);
+  const auto gids = io::owned_rows(disc.points.gid, n);
   auto file = io::PointFile::create(comm, folder + "/mesh.h5");
   const auto x = io::owned_rows(disc.points.x, n);
   file.write_points("coordinates", gids, disc.dist.n_global(), Dim, x.data());
@@ -43,7 +38,7 @@ void FieldOutput<Dim>::write(long long step, double time) {
   ScopedRegion region("mupm::Output::fields");
   const MPI_Comm comm = io::raw(*disc_.dist.comm());
   const std::size_t n = disc_.points.n_owned;
-  const auto gids = owned_gids(disc_.points.gid, n);
+  const auto gids = io::owned_rows(disc_.points.gid, n);
   const std::string name = fields_file(step);
   {
     auto file = io::PointFile::create(comm, folder_ + "/" + name);

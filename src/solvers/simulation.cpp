@@ -316,10 +316,7 @@ void restart(const RunSettings& run, Discretization<Dim>& disc, long long& step,
   try {
     read_checkpoint(run.restart_from, disc, step, time, history, globals);
   } catch (const CollectiveError& e) {
-    std::string msg = e.what();
-    if (msg.rfind("Error, ", 0) == 0)
-      msg = msg.substr(7);
-    throw InputError(where + msg);
+    throw InputError(restart_from_error(run.restart_from, e));
   }
   if (step >= run.n_steps)
     throw InputError(where + "the checkpoint is at step " + std::to_string(step) +

@@ -4,6 +4,7 @@
 #ifndef MUPM_CHECKPOINT_HPP
 #define MUPM_CHECKPOINT_HPP
 
+#include <exception>
 #include <string>
 #include <utility>
 #include <vector>
@@ -29,6 +30,10 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
 // dimension, number of points, spacing and horizon (what --validate can tell without the run).
 void check_checkpoint(MPI_Comm comm, const std::string& path, int dim, long long n_global,
                       double dx, double horizon);
+
+// A checkpoint error as the input error it is: "Error, mupm->Solver->Restart From = 'path': ..."
+// (the run and --validate both report it so).
+std::string restart_from_error(const std::string& path, const std::exception& e);
 
 // Collective restore of the step, the time, the output history, the point and bond fields and
 // the named globals; then the shape tensors of the restored bonds. Throws CollectiveError (on
