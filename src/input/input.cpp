@@ -79,9 +79,9 @@ void region_template(ParameterList& r) {
 }
 void crack_template(ParameterList& c) {
   c.set("Start", Array<double>(), "2D: first end of the crack segment [m].");
-  c.set("End", Array<double>(), "2D: second end of the crack segment [m].");
+  c.set("End", Array<double>(), "2D: second end of the crack segment [m]: the tip, from which crack_length measures growth.");
   c.set("Corner", Array<double>(), "3D: a corner of the crack rectangle [m].");
-  c.set("Edge 1", Array<double>(), "3D: first edge vector of the rectangle from Corner [m].");
+  c.set("Edge 1", Array<double>(), "3D: first edge vector of the rectangle from Corner [m]: the direction of growth for crack_length (the tip is the far edge).");
   c.set("Edge 2", Array<double>(),
         "3D: second edge vector of the rectangle from Corner [m], orthogonal to Edge 1.");
 }
@@ -256,7 +256,31 @@ RCP<ParameterList> valid_parameters() {
           "Darcy's law with gravity, q = -(k_r k / mu_w)(grad p - rho_w g) with g = "
           "Solver->Gravity (eq 54); false: q = -(k_r k / mu_w) grad p.");
   }
-  pl->sublist("Fracture", false, "Bond breakage and fracture flow (filled by the fracture issue).");
+  {
+    ParameterList& f = pl->sublist("Fracture", false,
+                                   "Bond breakage (Solver->Physics = Micropolar Solid or "
+                                   "Hydro-Mechanical), damage and fracture points.");
+    f.set("Bond Breakage", std::string("None"),
+          "None: bonds never break (pre-cracks stay as they are). Energy: a bond breaks once "
+          "its energy W (eq 34, accumulated from the force and moment states over the run) "
+          "reaches W_cr = 4 G_cr/(pi delta^4) in 3D (eq 36), 3 G_cr/(2 h delta^3) in 2D "
+          "(derivation in include/mupm/kernels/fracture.hpp); the energy it holds is booked "
+          "as fracture dissipation.",
+          bond_breaking_options().validator());
+    f.set("Critical Energy Release Rate", 0.0,
+          "G_cr [J/m^2 = N/m] of the Energy criterion (> 0 with it).", at_least(0.0));
+    f.set("Critical Damage", 0.3,
+          "D_cr in (0, 1]: a point with damage D >= D_cr (eq 37) is a fracture point (eq 104; "
+          "the paper gives no value). Points next to a pre-crack are fracture points from the "
+          "start.",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(1e-6, 1.0)));
+    f.set("Bond Energy Force State", std::string("Effective"),
+          "Force state whose work is the bond energy W (eq 34). Effective: the skeleton's, "
+          "sigma-bar K^-1 xi plus stabilization, as the paper's text says (Terzaghi: the "
+          "effective stress breaks the skeleton). Total: with the pore-water part "
+          "-S_r p K^-1 xi, as eq 34 is printed. The same without a fluid.",
+          bond_energy_state_options().validator());
+  }
   {
     ParameterList& b =
         pl->sublist("Boundary Conditions", false, "One sublist per condition, named as you like.");
@@ -653,6 +677,18 @@ void check_dimension_arrays(ParameterList& input) {
                                  : std::string("gives D <= 0 (Poisson's ratio >= 1/4)")) +
                        ": use Automatic or Bulk Matching.");
   }
+  const ParameterList& fr = input.sublist("Fracture");
+  if (bond_breaking_options()(fr.get<std::string>("Bond Breakage")) != BondBreaking::None) {
+    if (!has_solid(phys))
+      throw InputError("Error, " + path_of(fr, "Bond Breakage") + " = " +
+                       fr.get<std::string>("Bond Breakage") +
+                       " needs Solver->Physics = Micropolar Solid or Hydro-Mechanical (it is " +
+                       physics + "): bonds break by the work of the solid's force states.");
+    if (!(fr.get<double>("Critical Energy Release Rate") > 0))
+      throw InputError("Error, " + path_of(fr, "Critical Energy Release Rate") +
+                       " must be > 0 for " + path_of(fr, "Bond Breakage") + " = " +
+                       fr.get<std::string>("Bond Breakage") + ".");
+  }
 }
 
 void check_region(const ParameterList& c, const ParameterList& regions,
@@ -821,9 +857,13 @@ MemoryNeed memory_need_of(const ParameterList& input, int ranks) {
   const double ghosts = std::min(std::pow(side + 2 * r, Dim) - n, m.points - n);
   // Per point: the registry's fields, plus solver state, shape tensors and ghost-exchange buffers
   // (SolidState, FluidState, solver arrays, two MultiVectors of the widest refresh): 512 B in 2D,
-  // 1 KiB in 3D. Per bond: the bond registry, plus the sort keys of the neighbour build.
+  // 1 KiB in 3D. Per bond: the bond registry (with the pair force states of bond breakage),
+  // plus the sort keys of the neighbour build.
   const double per_point = double(Points<Dim>::bytes_per_point()) + (Dim == 2 ? 512 : 1024);
-  const double per_bond = double(Bonds::bytes_per_bond()) + sizeof(GlobalId);
+  const bool breaks = bond_breaking_options()(input.sublist("Fracture").get<std::string>(
+                          "Bond Breakage")) != BondBreaking::None;
+  const double per_bond =
+      double(Bonds::bytes_per_bond(breaks ? Dim + kRotDim<Dim> : 0)) + sizeof(GlobalId);
   m.bytes_per_rank = (n + ghosts) * per_point + n * m.bonds_per_point * per_bond;
   return m;
 }

@@ -37,6 +37,17 @@ const Options<RetentionModel>& retention_model_options() {
       {{"Saturated", RetentionModel::Saturated}, {"Van Genuchten", RetentionModel::VanGenuchten}});
   return o;
 }
+const Options<BondBreaking>& bond_breaking_options() {
+  static const Options<BondBreaking> o("Bond Breakage",
+                                       {{"None", BondBreaking::None}, {"Energy", BondBreaking::Energy}});
+  return o;
+}
+const Options<BondEnergyState>& bond_energy_state_options() {
+  static const Options<BondEnergyState> o(
+      "Bond Energy Force State",
+      {{"Effective", BondEnergyState::Effective}, {"Total", BondEnergyState::Total}});
+  return o;
+}
 const Options<BoundaryCondition::Kind>& boundary_condition_options() {
   static const Options<BoundaryCondition::Kind> o(
       "Type", {{"Displacement", BoundaryCondition::Displacement},
@@ -129,6 +140,15 @@ Model<Dim> model_from_input(const ParameterList& input) {
   }
   if (fluid.get<bool>("Gravity In Darcy Flux"))
     m.fluid.gravity = m.gravity;
+
+  const ParameterList& fracture = input.sublist("Fracture");
+  m.fracture.criterion = bond_breaking_options()(fracture.get<std::string>("Bond Breakage"));
+  m.fracture.critical_energy = critical_bond_energy<Dim>(
+      fracture.get<double>("Critical Energy Release Rate"), m.grid.horizon, m.grid.thickness);
+  m.fracture.critical_damage = fracture.get<double>("Critical Damage");
+  m.fracture.effective_state =
+      bond_energy_state_options()(fracture.get<std::string>("Bond Energy Force State")) ==
+      BondEnergyState::Effective;
 
   m.boundary_conditions = boundary_conditions_from_input(input);
   m.initial_conditions = initial_conditions_from_input(input);

@@ -48,16 +48,31 @@ BondLayout bond_layout(const Discretization<Dim>& disc, MPI_Comm comm) {
   return t;
 }
 
-// A per-bond View as its table (to_table) or back (from_table).
+// A per-bond View as its table (to_table) or back (from_table); a View of ncomp components per
+// bond takes ncomp columns per bond, bond after bond (row width width * ncomp).
+template <class V>
+std::size_t bond_components(const V& f) {
+  if constexpr (V::rank == 1)
+    return 1;
+  else
+    return f.extent(1);
+}
 template <class V>
 std::vector<typename V::value_type> to_table(const V& f, const View1<BondIndex>& offsets,
                                              std::size_t n, int width) {
   const auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), offsets);
   const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), f);
-  std::vector<typename V::value_type> t(n * std::size_t(width), typename V::value_type(0));
+  const std::size_t nc = bond_components(f), row = std::size_t(width) * nc;
+  std::vector<typename V::value_type> t(n * row, typename V::value_type(0));
   for (std::size_t i = 0; i < n; ++i)
     for (BondIndex b = off(i); b < off(i + 1); ++b)
-      t[i * std::size_t(width) + std::size_t(b - off(i))] = h(b);
+      for (std::size_t c = 0; c < nc; ++c) {
+        auto& cell = t[i * row + std::size_t(b - off(i)) * nc + c];
+        if constexpr (V::rank == 1)
+          cell = h(b);
+        else
+          cell = h(b, c);
+      }
   return t;
 }
 template <class V>
@@ -65,9 +80,16 @@ void from_table(const V& f, const View1<BondIndex>& offsets, std::size_t n, int 
                 const std::vector<typename V::value_type>& t) {
   const auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), offsets);
   auto h = Kokkos::create_mirror_view(f);
+  const std::size_t nc = bond_components(f), row = std::size_t(width) * nc;
   for (std::size_t i = 0; i < n; ++i)
     for (BondIndex b = off(i); b < off(i + 1); ++b)
-      h(b) = t[i * std::size_t(width) + std::size_t(b - off(i))];
+      for (std::size_t c = 0; c < nc; ++c) {
+        const auto cell = t[i * row + std::size_t(b - off(i)) * nc + c];
+        if constexpr (V::rank == 1)
+          h(b) = cell;
+        else
+          h(b, c) = cell;
+      }
   Kokkos::deep_copy(f, h);
 }
 
@@ -174,7 +196,8 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
     file.write_points("bonds/neighbor_gid", gids, n_global, t.width, t.neighbor_gid.data());
     for_each_checkpointed(disc.bonds, [&](const auto& view, const FieldSpec& s) {
       const auto rows = to_table(view, disc.bonds.offsets, n, t.width);
-      file.write_points(std::string("bonds/") + s.name, gids, n_global, t.width, rows.data());
+      file.write_points(std::string("bonds/") + s.name, gids, n_global, t.width * s.ncomp,
+                        rows.data());
     });
   }
   // Replace the previous checkpoint only once the new one is complete.
@@ -223,8 +246,9 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
                           "holds other bonds than this input makes (horizon, pre-cracks or "
                           "grid differ).");
   for_each_checkpointed(disc.bonds, [&](const auto& view, const FieldSpec& s) {
-    std::vector<typename std::decay_t<decltype(view)>::value_type> rows(t.neighbor_gid.size());
-    file.read_points(std::string("bonds/") + s.name, gids, t.width, rows.data());
+    std::vector<typename std::decay_t<decltype(view)>::value_type> rows(
+        t.neighbor_gid.size() * std::size_t(s.ncomp));
+    file.read_points(std::string("bonds/") + s.name, gids, t.width * s.ncomp, rows.data());
     from_table(view, disc.bonds.offsets, n, t.width, rows);
   });
   disc.update_shape();

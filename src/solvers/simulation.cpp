@@ -215,6 +215,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
     settings.rho_w = model.fluid.water_density;
     settings.gravity = model.gravity;
     settings.damping = model.damping;
+    settings.fracture = model.fracture;
     switch (model.constitutive_model) {
       case ConstitutiveModel::MicropolarElastic:
         ph.mechanics = std::make_unique<SolidSolver<Dim, MicropolarElastic>>(
@@ -224,7 +225,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   } else if (physics == Physics::KinematicsOnly) {
     ph.mechanics = std::make_unique<Kinematics<Dim>>(disc);
   }
-  ph.damage = std::make_unique<Damage<Dim>>(disc, mpi);
+  ph.damage = std::make_unique<Damage<Dim>>(disc, model.fracture.critical_damage, mpi);
   ph.spacing = disc.grid.dx;
   ph.sequence.mechanics = ph.mechanics.get();
   ph.sequence.fluid = ph.fluid.get();
@@ -237,7 +238,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
 // Prints the size of the discretization; returns the global number of bonds.
 template <int Dim>
 long long report_discretization(const Discretization<Dim>& disc, const Teuchos::Comm<int>& comm,
-                                std::ostream& out) {
+                                int pair_width, std::ostream& out) {
   long long counts[2] = {static_cast<long long>(disc.bonds.size()),
                          static_cast<long long>(disc.points.n_ghost)};
   MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_LONG_LONG, MPI_SUM, io::raw(comm));
@@ -248,7 +249,8 @@ long long report_discretization(const Discretization<Dim>& disc, const Teuchos::
         << " m, horizon = " << g.horizon << " m (" << g.horizon / g.dx << " dx)\n"
         << "mupm: " << comm.getSize() << " rank(s) x " << ExecSpace().concurrency() << " "
         << ExecSpace::name() << " thread(s); " << Points<Dim>::bytes_per_point()
-        << " bytes per point, " << Bonds::bytes_per_bond() << " bytes per bond\n";
+        << " bytes per point, " << Bonds::bytes_per_bond(pair_width)
+        << " bytes per bond\n";
   return counts[0];
 }
 
@@ -572,7 +574,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
 
   Discretization<Dim> disc = discretize(comm, model.grid);
   Points<Dim>& pts = disc.points;
-  const long long n_bonds = report_discretization(disc, *comm, out);
+  const int pair_width = model.fracture.criterion != BondBreaking::None ? Dim + kRotDim<Dim> : 0;
+  const long long n_bonds = report_discretization(disc, *comm, pair_width, out);
   const long long n_global = disc.dist.n_global();
   check_regions(model, disc, mpi);
   initial_state(model, pts);

@@ -21,7 +21,12 @@ struct Bonds {
   View1<LocalId> neighbor;   // local index (owned or ghost) of the other end
   // State.
   Bytes intact;    // 1 intact, 0 broken (the paper's rho; influence omega = 1 * intact)
-  Scalars energy;  // accumulated bond energy W_ij (eq 34)
+  Scalars energy;  // accumulated bond energy W_ij (eq 34), per pair of unit volumes [J/m^6]
+  // The pair's force and moment states (T_ij - T_ji, M_ij - M_ji) of the last force evaluation
+  // [n_bonds][pair_width], for the trapezoid rule of the bond energy (include/mupm/kernels/
+  // solid.hpp). Held only by runs that break bonds (pair_width = Dim + RotDim, else 0).
+  Vectors pair_force;
+  int pair_width = 0;
 
   template <class F>
   void for_each_field(F&& f) {
@@ -39,10 +44,18 @@ struct Bonds {
   void allocate_state(std::size_t n) {
     for_each_field([n](auto& view, const FieldSpec& s) { allocate_field(view, s, n); });
   }
+  // Adds the pair force states of bond breakage (width Dim + RotDim), zero.
+  void hold_pair_forces(int width) {
+    pair_width = width;
+    pair_force = Vectors("mupm::bond_pair_force", size(), std::size_t(width));
+  }
 
-  static std::size_t bytes_per_bond() {
+  // Resident bytes of one bond; pair_width: that of a run that breaks bonds (0: none).
+  static std::size_t bytes_per_bond(int pair_width = 0) {
     std::size_t b = sizeof(LocalId);
-    Bonds().for_each_field([&b](const auto& view, const FieldSpec& s) {
+    Bonds probe;
+    probe.pair_width = pair_width;
+    probe.for_each_field([&b](const auto& view, const FieldSpec& s) {
       b += sizeof(typename std::decay_t<decltype(view)>::value_type) * std::size_t(s.ncomp);
     });
     return b;
@@ -53,6 +66,8 @@ struct Bonds {
   static void visit(B& b, F& f) {
     f(b.intact, FieldSpec{"intact", 1, kCheckpoint});
     f(b.energy, FieldSpec{"energy", 1, kCheckpoint});
+    if (b.pair_width > 0)
+      f(b.pair_force, FieldSpec{"pair_force", b.pair_width, kCheckpoint});
   }
 };
 

@@ -69,6 +69,8 @@ struct Points {
   // Fracture.
   Scalars damage;  // D_i (eq 37)
   Bytes fracture;  // 1: fracture point (D >= D_cr or next to a pre-crack)
+  Scalars bond_energy_released;  // energy released by the point's broken bonds [J], half of
+                                 // W V_i V_j per bond (the other half is at the other end)
   // Constitutive state: effective stress, couple stress, equivalent plastic strain.
   Vectors stress;                 // sigma-bar [n][Dim*Dim], row-major, non-symmetric
   Vectors couple_stress;          // m [n][RotDim*Dim]
@@ -165,7 +167,8 @@ struct Points {
     f(p.solid_pressure,    FieldSpec{"solid_pressure", 1, kCheckpoint});
     f(p.undrained_modulus, FieldSpec{"undrained_modulus", 1, 0});
     f(p.damage,            FieldSpec{"damage", 1, kState | kGhosted});
-    f(p.fracture,          FieldSpec{"fracture", 1, kConstant | kState});
+    f(p.fracture,          FieldSpec{"fracture", 1, kState});
+    f(p.bond_energy_released, FieldSpec{"bond_energy_released", 1, kState});
     f(p.stress,            FieldSpec{"stress", D * D, kState});
     f(p.couple_stress,     FieldSpec{"couple_stress", R * D, kState});
     f(p.plastic_strain,    FieldSpec{"plastic_strain", 1, kState});

@@ -75,6 +75,7 @@ struct Model {
   double solid_density = 2000;  // rho_s
   double damping = 0;           // Solver->Damping
   FluidParams fluid;
+  FractureParams fracture;
   double porosity = 0;                 // Materials->Porosity (initial)
   Kokkos::Array<double, 3> gravity{};  // Solver->Gravity
   std::vector<BoundaryCondition> boundary_conditions;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "mupm/kernels/boundary_conditions.hpp"
+#include "mupm/kernels/fracture.hpp"
 #include "mupm/laws/stabilization.hpp"
 
 namespace mupm {
@@ -29,6 +30,8 @@ enum class Staggering { SolidFirst, FluidFirst };
 enum class ConstitutiveModel { MicropolarElastic };
 // Fluid->Retention Model.
 enum class RetentionModel { Saturated, VanGenuchten };
+// Fracture->Bond Energy Force State.
+enum class BondEnergyState { Effective, Total };
 
 template <class E>
 class Options {
@@ -72,6 +75,8 @@ const Options<Staggering>& staggering_options();
 const Options<ConstitutiveModel>& constitutive_model_options();
 const Options<StabilizationModulus>& stabilization_modulus_options();
 const Options<RetentionModel>& retention_model_options();
+const Options<BondBreaking>& bond_breaking_options();
+const Options<BondEnergyState>& bond_energy_state_options();
 const Options<BoundaryCondition::Kind>& boundary_condition_options();
 const Options<TimeFunction::Kind>& time_function_options();
 // Boundary Conditions->NAME->Component: the axis (x, y, z) as 0, 1, 2.

@@ -57,6 +57,12 @@ struct SolidParams {
   double horizon_volume = 0;   // volume of a full continuous family (pi delta^2 h, 4/3 pi delta^3)
 };
 
+// What pass 2 does with the bond energy W (eq 34; include/mupm/kernels/fracture.hpp):
+// Off: nothing (stable-step estimates, tests of the forces); Record: keep each bond's pair force
+// state as the start of the next step's trapezoid; Accumulate: W += the trapezoid of the pair
+// force states over the step's increment, then record.
+enum class BondWork { Off, Record, Accumulate };
+
 template <int Dim>
 struct SolidState {
   static constexpr int R = kRotDim<Dim>;
@@ -68,6 +74,12 @@ struct SolidState {
   Vectors moment;      // moment density [n_owned][R]
   Scalars energy;      // V_i (W_i + stabilization energy density) [n_owned]
   Scalars pstar;       // p* of this evaluation (undrained split, below) [n_owned]
+  // Bond energy (runs that break bonds): the step's increment of (u, theta) [n_all][Dim + R]
+  // (ghosts refreshed by the solver with u), and S_r p* K^-1 [n_all][Dim*Dim] when the energy
+  // takes the effective force state with a fluid (allocated then only; pass 1 fills it).
+  BondWork work = BondWork::Off;
+  Vectors increment;
+  Vectors P1w;
 
   void allocate(std::size_t n_all, std::size_t n_owned) {
     eps = Vectors("mupm::eps", n_all, Dim * Dim);
@@ -82,7 +94,12 @@ struct SolidState {
     pstar = Scalars("mupm::solid_pore_pressure", n_owned);
   }
   // What pass 2 reads from the neighbours, besides u and theta.
-  std::vector<Vectors> pass2_ghosts() const { return {eps, kappa, P1, P2, as_vectors(w0)}; }
+  std::vector<Vectors> pass2_ghosts() const {
+    std::vector<Vectors> g{eps, kappa, P1, P2, as_vectors(w0)};
+    if (P1w.extent(0) > 0)
+      g.push_back(P1w);
+    return g;
+  }
 };
 
 // Kinematics of bond i -> j (eqs 2-9): xi = x_j - x_i, the composite relative displacement
@@ -128,6 +145,8 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
   auto degen = st.degenerate;
   auto energy = st.energy;
   auto pstar = st.pstar;
+  auto P1w = st.P1w;
+  const bool effective = P1w.extent(0) > 0;
   auto Kinv_v = shape.Kinv, fam = shape.family_volume;
   auto sing = shape.singular;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;  // G C1 |xi|^3
@@ -221,6 +240,9 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
           P2(i, k) = p2[k];
           m_v(i, k) = m[k];
         }
+        if (effective)
+          for (int k = 0; k < Dim * Dim; ++k)
+            P1w(i, k) = sr(i) * pe * Kinv[k];  // the pore-water part of P1, with opposite sign
         w0_v(i) = w0;
         pstar(i) = pe;
         degen(i) = singular ? 1 : 0;
@@ -231,7 +253,23 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
 // Pass 2 (per owned point, full neighbour list, no atomics): force and moment densities
 // (eqs 105-112): f_i = sum_j (T_ij - T_ji) V_j,
 // l_i = sum_j (M_ij - M_ji) V_j + 1/2 sum_j xi x (T_ij - T_ji) V_j. Needs the ghosts' u, theta,
-// eps, kappa, P1, P2, w0.
+// eps, kappa, P1, P2, w0 (and increment, P1w when st.work is on).
+//
+// Bond energy (eq 34, FORMULATION "Fracture"), with st.work = Accumulate: per pair of unit
+// volumes, dW = (T_ij - T_ji).dU^ + (M_ij - M_ji).dOmega, integrated over the step by the
+// trapezoid rule between the pair states of the last evaluation (Bonds::pair_force) and this
+// one. Summed over the pairs (times V_i V_j) this is exactly the work of the forces f, l on the
+// step's increments, the trapezoid the solid solver books as external work: elastic energy is
+// neither made nor lost by the bookkeeping. The pair states are assembled as
+// (P1_i xi + P1_j xi) + (stab_i + stab_j), every sum of an i term and a j term, so that the
+// copy j -> i evaluates exactly the negated numbers: both copies of a bond hold the same W to the
+// last bit on any number of ranks, and break on the same step. The increments dU^, dOmega come
+// from the per-point increments the same way (the step's change of U^ and Omega, exactly, as
+// both are linear in u and theta).
+// Which force state (eq 34 adds S_r T_w to the effective state, making it the total one; the
+// text says effective): with st.P1w allocated, the effective state, the pore-water part
+// -(S_r p* K^-1 xi) of each end taken out: the skeleton's bonds break by the skeleton's stress
+// (Terzaghi). Without it (no fluid, or Fracture->Bond Energy Force State = Total) the total.
 template <int Dim>
 void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& prm,
                  SolidState<Dim>& st) {
@@ -239,12 +277,18 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   auto offsets = bonds.offsets;
   auto neighbor = bonds.neighbor;
   auto intact = bonds.intact;
+  auto W = bonds.energy;
+  auto pair = bonds.pair_force;
   auto x = pts.x, u = pts.u, th = pts.theta;
   auto vol = pts.volume;
   auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, w0 = st.w0;
+  auto inc = st.increment, P1w = st.P1w;
   auto force = st.force, moment = st.moment;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
   const double c2 = prm.stabilization * prm.stab_modulus;
+  const bool record = st.work != BondWork::Off && bonds.pair_width == Dim + R;
+  const bool accumulate = record && st.work == BondWork::Accumulate;
+  const bool effective = P1w.extent(0) > 0;
   Kokkos::parallel_for(
       "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         double f[Dim] = {}, l[R] = {};
@@ -261,7 +305,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           const double a1j = w0(j) > 0 ? a1 / w0(j) : 0.0, a2j = w0(j) > 0 ? a2 / w0(j) : 0.0;
           // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
           //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
-          double t[Dim];
+          double t[Dim], m[R];
           for (int a = 0; a < Dim; ++a) {
             double pi = 0, pj = 0, ei = 0, ej = 0;
             for (int k = 0; k < Dim; ++k) {
@@ -270,7 +314,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
               ei += eps(i, a * Dim + k) * xi[k];
               ej += eps(j, a * Dim + k) * xi[k];
             }
-            t[a] = pi + pj + a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej);
+            t[a] = (pi + pj) + (a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej));
             f[a] += t[a] * vj;
           }
           // M_ij - M_ji, Omega_ji = -Omega_ij.
@@ -282,12 +326,40 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
               ki += kap(i, r * Dim + k) * xi[k];
               kj += kap(j, r * Dim + k) * xi[k];
             }
-            l[r] += (pi + pj + a2i * (Om[r] - ki) + a2j * (Om[r] - kj)) * vj;
+            m[r] = (pi + pj) + (a2i * (Om[r] - ki) + a2j * (Om[r] - kj));
+            l[r] += m[r] * vj;
           }
           double xt[R];
           cross<Dim>(xi, t, xt);  // 1/2 xi x (T_ij - T_ji)
           for (int r = 0; r < R; ++r)
             l[r] += 0.5 * xt[r] * vj;
+          if (record) {
+            if (effective)  // take out -(S_r p* K^-1 xi) of both ends (header)
+              for (int a = 0; a < Dim; ++a) {
+                double wi = 0, wj = 0;
+                for (int k = 0; k < Dim; ++k) {
+                  wi += P1w(i, a * Dim + k) * xi[k];
+                  wj += P1w(j, a * Dim + k) * xi[k];
+                }
+                t[a] += wi + wj;
+              }
+            if (accumulate) {
+              // dU^ = d(u_j - u_i) - (d theta_i + d theta_j)/2 x xi, dOmega = d theta_j - d theta_i.
+              double tb[R], c[Dim], dw = 0;
+              for (int r = 0; r < R; ++r)
+                tb[r] = 0.5 * (inc(i, Dim + r) + inc(j, Dim + r));
+              rot_cross<Dim>(tb, xi, c);
+              for (int a = 0; a < Dim; ++a)
+                dw += 0.5 * (pair(b, a) + t[a]) * (inc(j, a) - inc(i, a) - c[a]);
+              for (int r = 0; r < R; ++r)
+                dw += 0.5 * (pair(b, Dim + r) + m[r]) * (inc(j, Dim + r) - inc(i, Dim + r));
+              W(b) += dw;
+            }
+            for (int a = 0; a < Dim; ++a)
+              pair(b, a) = t[a];
+            for (int r = 0; r < R; ++r)
+              pair(b, Dim + r) = m[r];
+          }
         }
         for (int d = 0; d < Dim; ++d)
           force(i, d) = f[d];

@@ -1,10 +1,27 @@
-// The damage module: the damage of every point from its intact bonds (eq 37) after the
-// mechanics step, and its time-series columns. The fracture issue adds bond breakage here
-// (Algorithm 4: after the solid step, before the fluid step).
+// The damage module: the damage of every point from its intact bonds (eq 37) and the fracture
+// points (eq 104) after the mechanics step (the solid breaks the bonds, Algorithm 4, at the end
+// of its step: include/mupm/solvers/solid_solver.hpp), and its time-series columns: broken
+// bonds, mean damage and, with a pre-crack, the crack's length and tip.
+//
+// Crack length and tip (2D and 3D), for the first pre-crack: its tip T is End in 2D (the
+// segment Start -> End grows from End) and Corner + Edge 1 in 3D (the rectangle grows along
+// Edge 1); d is the unit vector from Start (Corner) to T. The crack's grown part is the largest
+// projection s = (x - T).d over the real points (not boundary layers) that are fracture points
+// and not next to the pre-crack, if positive; the tip is that point (the lowest global id among
+// equals), else T. crack_length = (length of the segment Start -> T inside the real body) + s.
+// For an edge crack from a face this is the distance from the face to the farthest fracture
+// point along the crack's direction, as the paper measures it. Damage elsewhere ahead of the
+// crack (e.g. at a loaded face) would count too: look at the damage field when in doubt.
 #ifndef MUPM_SOLVERS_DAMAGE_HPP
 #define MUPM_SOLVERS_DAMAGE_HPP
 
 #include <mpi.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
 
 #include "mupm/kernels/damage.hpp"
 #include "mupm/mesh/discretization.hpp"
@@ -15,11 +32,12 @@ namespace mupm {
 template <int Dim>
 class Damage : public Module {
  public:
-  Damage(Discretization<Dim>& disc, MPI_Comm comm) : disc_(disc), comm_(comm) {}
+  Damage(Discretization<Dim>& disc, double critical_damage, MPI_Comm comm)
+      : disc_(disc), critical_damage_(critical_damage), comm_(comm) {}
 
   const char* name() const override { return "damage"; }
 
-  void update() { compute_damage(disc_.bonds, disc_.points); }
+  void update() { compute_damage(disc_.bonds, disc_.points, critical_damage_); }
 
   // Volume-weighted mean damage and the number of broken bonds (each bond is listed by both
   // its ends). Sums over ranks in a fixed order would be needed for bit-equal sums; these are
@@ -45,10 +63,111 @@ class Damage : public Module {
     MPI_Allreduce(MPI_IN_PLACE, &broken, 1, MPI_LONG_LONG, MPI_SUM, comm_);
     row("mean_damage", sums[1] > 0 ? sums[0] / sums[1] : 0.0);
     row("broken_bonds", double(broken) / 2);
+    if (disc_.grid.cracks.empty())
+      return;
+    const Tip tip = crack_tip();
+    row("crack_length", tip.length);
+    const char* names[3] = {"crack_tip_x", "crack_tip_y", "crack_tip_z"};
+    for (int d = 0; d < Dim; ++d)
+      row(names[d], tip.x[d]);
+  }
+
+  struct Tip {
+    double length = 0;
+    std::array<double, 3> x{};
+  };
+  // The first pre-crack's length and tip now (header). Collective.
+  Tip crack_tip() const {
+    const Crack& c = disc_.grid.cracks.front();
+    double S[3] = {0, 0, 0}, T[3] = {0, 0, 0}, d[3] = {0, 0, 0}, len = 0;
+    for (int k = 0; k < Dim; ++k) {
+      S[k] = c.a[k];
+      T[k] = Dim == 2 ? c.b[k] : c.a[k] + c.b[k];
+      d[k] = T[k] - S[k];
+      len += d[k] * d[k];
+    }
+    len = std::sqrt(len);
+    for (int k = 0; k < Dim; ++k)
+      d[k] /= len;
+    const auto& p = disc_.points;
+    auto x = p.x;
+    auto gid = p.gid;
+    auto frac = p.fracture;
+    auto flags = p.flags;
+    // Largest s, then the lowest global id among the points that have it.
+    double best = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Diagnostics::crack_extent", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& m) {
+          if (!frac(i) || (flags(i) & (kFlagPreCrack | kFlagBoundaryLayer)))
+            return;
+          double s = 0;
+          for (int k = 0; k < Dim; ++k)
+            s += (x(i, k) - T[k]) * d[k];
+          m = s > m ? s : m;
+        },
+        Kokkos::Max<double>(best));
+    MPI_Allreduce(MPI_IN_PLACE, &best, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    long long who = -1;
+    if (best > 0) {
+      long long mine = std::numeric_limits<long long>::max();
+      Kokkos::parallel_reduce(
+          "mupm::Diagnostics::crack_tip", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, long long& m) {
+            if (!frac(i) || (flags(i) & (kFlagPreCrack | kFlagBoundaryLayer)))
+              return;
+            double s = 0;
+            for (int k = 0; k < Dim; ++k)
+              s += (x(i, k) - T[k]) * d[k];
+            if (s == best && (long long)gid(i) < m)
+              m = (long long)gid(i);
+          },
+          Kokkos::Min<long long>(mine));
+      MPI_Allreduce(&mine, &who, 1, MPI_LONG_LONG, MPI_MIN, comm_);
+    }
+    Tip tip;
+    tip.length = inside_length(S, T) + std::max(best, 0.0);
+    double xt[3] = {T[0], T[1], T[2]};
+    if (who >= 0) {
+      const auto xh = Kokkos::create_mirror_view_and_copy(HostSpace(), p.x);
+      const auto gh = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
+      double mine[3] = {0, 0, 0};
+      for (std::size_t i = 0; i < p.n_owned; ++i)
+        if ((long long)gh(i) == who)
+          for (int k = 0; k < Dim; ++k)
+            mine[k] = xh(i, k);
+      MPI_Allreduce(mine, xt, 3, MPI_DOUBLE, MPI_SUM, comm_);
+    }
+    for (int k = 0; k < 3; ++k)
+      tip.x[k] = xt[k];
+    return tip;
   }
 
  private:
+  // Length of the segment S -> T inside the real body (a box).
+  double inside_length(const double* S, const double* T) const {
+    const auto& g = disc_.grid;
+    double lo = 0, hi = 1, len2 = 0;
+    for (int k = 0; k < Dim; ++k) {
+      const double a = g.origin[k], b = g.origin[k] + double(g.counts[k]) * g.dx;
+      const double dk = T[k] - S[k];
+      len2 += dk * dk;
+      if (dk == 0) {
+        if (S[k] < a || S[k] > b)
+          return 0;
+        continue;
+      }
+      double t0 = (a - S[k]) / dk, t1 = (b - S[k]) / dk;
+      if (t0 > t1)
+        std::swap(t0, t1);
+      lo = std::max(lo, t0);
+      hi = std::min(hi, t1);
+    }
+    return hi > lo ? (hi - lo) * std::sqrt(len2) : 0.0;
+  }
+
   Discretization<Dim>& disc_;
+  double critical_damage_;
   MPI_Comm comm_;
 };
 

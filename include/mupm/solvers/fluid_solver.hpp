@@ -19,14 +19,17 @@
 // Energy (eqs 147-149, in power form): multiplying the mass balance by p gives
 //   d/dt sum V psi(p) = -sum V S_r p dV_s/dt - sum V p div + sum V p s + sum p supply,
 // psi the stored energy density (include/mupm/kernels/fluid.hpp). The update books the flow
-// dissipation D and the external work W_ext (sources and reservoirs) with the pressure at the
-// start of each step (the rate forward Euler uses), and the coupling work W_c (the water's
-// work on the skeleton) with the step's mean pressure (the undrained response to a volume
-// change is exact, not a forward-Euler rate). With constant C the balance
-// E_s(t) - E_s(0) + W_c + D - W_ext then differs from zero by sum V dp dt (s - div) / 2 per
-// step: the forward-Euler error of the flow alone, first order in dt for a smooth evolution and
-// growing without bound when the step is unstable. The driver checks it against
-// Solver->Energy Tolerance like the solid's (eq 149).
+// dissipation D with the pressure at the start of each step (the rate forward Euler uses), and
+// the coupling work W_c (the water's work on the skeleton) and the external work W_ext (sources
+// and reservoirs) with the step's mean pressure p + dp/2 (trapezoid: a source's or a
+// reservoir's water enters at the pressure it meets over the step, and the undrained response
+// to a volume change is exact, not a forward-Euler rate). With constant C,
+// E_s(t+dt) - E_s(t) = sum V (p + dp/2) C dp exactly, so the balance
+// E_s(t) - E_s(0) + W_c + D - W_ext differs from zero by -sum V dp dt div / 2 per step: the
+// forward-Euler error of the flow alone, first order in dt for a smooth evolution and growing
+// without bound when the step is unstable. (Booking sources with the start pressure, as
+// before, made a point source's first steps, where its pressure rises fastest, draw false
+// alarms.) The driver checks it against Solver->Energy Tolerance like the solid's (eq 149).
 #ifndef MUPM_FLUID_SOLVER_HPP
 #define MUPM_FLUID_SOLVER_HPP
 
@@ -341,9 +344,10 @@ class FluidSolver : public Module {
             dp = C(i) > 0 ? rhs / C(i) : 0.0;  // eq 143
             target(i) = 0;
           }
-          wc += vol(i) * (p0 + 0.5 * dp) * sr(i) * dv;
+          const double pm = p0 + 0.5 * dp;  // the step's mean pressure
+          wc += vol(i) * pm * sr(i) * dv;
           wd += vol(i) * p0 * dt * flow(i);
-          we += vol(i) * p0 * dt * src(i) + p0 * target(i);
+          we += vol(i) * pm * dt * src(i) + pm * target(i);
           m(i) += C(i) * dp + sr(i) * dv;
           rate(i) = dp / dt;
           pw(i) = p0 + dp;  // eq 145, beta_3 = 0

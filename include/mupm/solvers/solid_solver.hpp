@@ -1,5 +1,9 @@
 // The solid step of Algorithm 1 for the elastic micropolar solid: boundary conditions, forces,
-// central difference, energy bookkeeping (eqs 137-140), reactions, stable-step estimate.
+// central difference, energy bookkeeping (eqs 137-140), reactions, stable-step estimate, and
+// energy-based bond breakage (eqs 34-36, Algorithm 4): the bond energies are accumulated by the
+// force evaluation of each step; bonds whose energy reached W_cr break at the end of the step's
+// force evaluation, before the velocity update (so the step's accelerations, and the next step's
+// first half of the work, are those of the new bond set), and before the fluid (Algorithm 1).
 #ifndef MUPM_SOLID_SOLVER_HPP
 #define MUPM_SOLID_SOLVER_HPP
 
@@ -13,6 +17,7 @@
 
 #include "mupm/kernels/boundary_conditions.hpp"
 #include "mupm/kernels/central_difference.hpp"
+#include "mupm/kernels/fracture.hpp"
 #include "mupm/kernels/solid.hpp"
 #include "mupm/mesh/discretization.hpp"
 #include "mupm/solvers/module.hpp"
@@ -47,19 +52,23 @@ class SolidSolver : public Mechanics {
     double rho_s = 2000, rho_w = 1000;
     Kokkos::Array<double, 3> gravity{};
     double damping = 0;
+    FractureParams fracture;
   };
   struct Energy {
     double internal = 0, kinetic = 0, external_work = 0, dissipation = 0;
+    double fracture = 0;  // strain energy lost when bonds broke (fracture dissipation)
+    double bond_energy = 0;  // sum of W V_i V_j of the broken bonds (the criterion's energy)
     // Work of the pore water on the skeleton: sum over steps of sum_i V_i S_r p* d(tr eps_i)
     // (the -S_r p* 1 part of the total stress, eq 46; p* linear in tr eps within a step, so the
     // trapezoid rule is exact).
     double pore_work = 0;
     // E_int + E_kin + D - W_ext - W_pore, which the scheme keeps constant (eq 140).
-    double balance() const { return internal + kinetic + dissipation - external_work - pore_work; }
+    double balance() const {
+      return internal + kinetic + dissipation + fracture - external_work - pore_work;
+    }
     double scale() const {
-      return std::max(
-          std::max(std::abs(internal), kinetic),
-          std::max(std::max(std::abs(external_work), dissipation), std::abs(pore_work)));
+      return std::max(std::max(std::max(std::abs(internal), kinetic), fracture),
+                      std::max(std::max(std::abs(external_work), dissipation), std::abs(pore_work)));
     }
   };
 
@@ -74,9 +83,16 @@ class SolidSolver : public Mechanics {
     inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
     body_ = Vectors("mupm::body_force", p.n_owned, Dim);
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
-    du_ = Vectors("mupm::step_increment", p.n_owned, Dim + R);
+    du_ = Vectors("mupm::step_increment", breaks() ? p.size() : p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
+    if (breaks()) {
+      disc_.bonds.hold_pair_forces(Dim + R);
+      st_.increment = du_;
+      if (set_.fracture.effective_state)
+        st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
+    }
   }
+  bool breaks() const { return set_.fracture.criterion != BondBreaking::None; }
 
   const SolidState<Dim>& state() const { return st_; }
   const SolidParams& params() const { return prm_; }
@@ -90,6 +106,10 @@ class SolidSolver : public Mechanics {
     g("dissipation", dissipation_);
     g("pore_pressure_work", pore_work_);
     g("initial_balance", balance0_);
+    if (breaks())
+      g("fracture_energy", fracture_energy_);
+    if (breaks())
+      g("bond_energy_released", bond_energy_released_);
   }
   void series(SeriesRow& row) const override {
     const auto e = energy();
@@ -98,6 +118,10 @@ class SolidSolver : public Mechanics {
     row("external_work", e.external_work);
     row("dissipation", e.dissipation);
     row("pore_pressure_work", e.pore_work);
+    if (breaks()) {
+      row("fracture_energy", e.fracture);
+      row("bond_energy_released", e.bond_energy);
+    }
     row("energy_error", e.balance() - balance0_);
     const auto names = reaction_names();
     const auto values = reactions();
@@ -109,7 +133,8 @@ class SolidSolver : public Mechanics {
     const auto e = energy();
     EnergyBalance b;
     b.what = "solid";
-    b.expression = "E_int + E_kin + D - W_ext - W_pore - E_0";
+    b.expression =
+        breaks() ? "E_int + E_kin + D + D_frac - W_ext - W_pore - E_0" : "E_int + E_kin + D - W_ext - W_pore - E_0";
     b.error = std::abs(e.balance() - balance0_);
     b.scale = e.scale();
     b.stored_expression = "E_int + E_kin";
@@ -143,6 +168,9 @@ class SolidSolver : public Mechanics {
     if (!restarted)
       apply_kinematic(bcs_, p, t, 0.0);
     disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
+    // The pair force states of this state start the bond energies' trapezoid (a restart's
+    // checkpoint holds the same numbers).
+    st_.work = breaks() ? BondWork::Record : BondWork::Off;
     forces(t);
     // Points::solid_pressure is the p* of the forces last applied (the pore work of the next
     // step starts from it); a restart has it from the checkpoint, not from the pressure the
@@ -163,21 +191,58 @@ class SolidSolver : public Mechanics {
     advance_positions(p, dt);
     apply_kinematic(bcs_, p, t, dt);
     increments();
-    // Work, dissipation and pore work of the step (this rank's points), then one reduction.
-    double w[3] = {0.5 * power(), 0, 0};  // old forces on the increment (trapezoid, first half)
+    // Work, dissipation, pore work and bond breakage of the step (this rank's points), then one
+    // reduction.
+    // w[0]: old forces on the increment (trapezoid, first half).
+    double w[6] = {0.5 * power(), 0, 0, 0, 0, 0};
     Kokkos::deep_copy(vs_old_,
                       Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
+    st_.work = breaks() ? BondWork::Accumulate : BondWork::Off;
     forces(t + dt);
     w[0] += 0.5 * power();  // new forces (second half)
     w[1] = dt * damping_power();
     w[2] = pore_power();
     keep_applied_pressure();
-    MPI_Allreduce(MPI_IN_PLACE, w, 3, MPI_DOUBLE, MPI_SUM, comm_);
+    if (breaks()) {
+      const Breakage br =
+          break_bonds(p, disc_.bonds, set_.fracture.critical_energy, p.bond_energy_released);
+      w[3] = double(br.bonds);
+      w[4] = br.energy;
+      w[5] = stored_energy();
+    }
+    MPI_Allreduce(MPI_IN_PLACE, w, 6, MPI_DOUBLE, MPI_SUM, comm_);
     work_ += w[0];
     dissipation_ += w[1];
     pore_work_ += w[2];
+    bond_energy_released_ += w[4];
+    if (w[3] > 0) {
+      // Bonds broke: K, its inverse and the family volumes change at their ends (and with them
+      // eps, kappa and the forces). The forces of the new bond set drive the velocity update
+      // and open the next step's trapezoids (work and bond energies). The fracture dissipation
+      // is the strain energy the body lost in the breakage, at the same u and theta: in the
+      // correspondence model a point's energy is its family's, not a sum over its bonds, so
+      // the broken bonds' W (what the criterion compares with W_cr, bond_energy_released) is
+      // not what the body loses; the loss is what closes the energy balance (eq 140).
+      disc_.update_shape();
+      st_.work = BondWork::Record;
+      forces(t + dt);
+      keep_applied_pressure();
+      double after = stored_energy();
+      MPI_Allreduce(MPI_IN_PLACE, &after, 1, MPI_DOUBLE, MPI_SUM, comm_);
+      fracture_energy_ += w[5] - after;
+    }
     advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                        set_.damping, dt);
+  }
+
+  // Strain energy (elastic and stabilization) of this rank's points.
+  double stored_energy() const {
+    auto en = st_.energy;
+    double e = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::stored_energy", range(0, disc_.points.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += en(i); }, e);
+    return e;
   }
 
   Energy energy() const {
@@ -202,7 +267,15 @@ class SolidSolver : public Mechanics {
         },
         e[0], e[1]);
     MPI_Allreduce(MPI_IN_PLACE, e, 2, MPI_DOUBLE, MPI_SUM, comm_);
-    return {e[0], e[1], work_, dissipation_, pore_work_};
+    Energy out;
+    out.internal = e[0];
+    out.kinetic = e[1];
+    out.external_work = work_;
+    out.dissipation = dissipation_;
+    out.pore_work = pore_work_;
+    out.fracture = fracture_energy_;
+    out.bond_energy = bond_energy_released_;
+    return out;
   }
 
   // Force (moment) the boundary applies on each kinematic condition's points: -sum f V.
@@ -265,6 +338,8 @@ class SolidSolver : public Mechanics {
     Kokkos::deep_copy(ref0, p.vol_strain_ref);
     Kokkos::deep_copy(p.p, 0.0);  // the operator's linear part only
     Kokkos::deep_copy(p.vol_strain_ref, 0.0);
+    const BondWork work = st_.work;
+    st_.work = BondWork::Off;  // the iterates are no motion of the body
     const Operator op{p.u, p.theta, st_.force, st_.moment, rho_, inertia_, p.fixed};
     const double lambda = largest_eigenvalue(
         op, Dim + R, p.n_owned, p.gid, p.volume,
@@ -279,6 +354,7 @@ class SolidSolver : public Mechanics {
     Kokkos::deep_copy(p.vol_strain_ref, ref0);
     disc_.dist.refresh({p.u, p.theta});
     solid_forces(disc_, prm_, law_, st_);
+    st_.work = work;
     return lambda > 0 ? 2.0 / std::sqrt(lambda) : 0.0;
   }
 
@@ -310,7 +386,10 @@ class SolidSolver : public Mechanics {
 
   void forces(double t) {
     auto& p = disc_.points;
-    disc_.dist.refresh({p.u, p.theta});
+    if (st_.work == BondWork::Accumulate)
+      disc_.dist.refresh({p.u, p.theta, du_});
+    else
+      disc_.dist.refresh({p.u, p.theta});
     solid_forces(disc_, prm_, law_, st_);
     body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
     auto eps = st_.eps;
@@ -430,6 +509,8 @@ class SolidSolver : public Mechanics {
   Vectors body_, couple_, du_;
   Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
+  double fracture_energy_ = 0;       // strain energy lost to bond breakage since t = 0 [J]
+  double bond_energy_released_ = 0;  // W V_i V_j of the bonds broken since t = 0 [J]
 };
 
 }  // namespace mupm
