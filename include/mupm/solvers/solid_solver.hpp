@@ -1,9 +1,9 @@
 // The solid step of Algorithm 1 for the elastic micropolar solid: boundary conditions, forces,
 // central difference, energy bookkeeping (eqs 137-140), reactions, stable-step estimate, and
 // energy-based bond breakage (eqs 34-36, Algorithm 4): the bond energies are accumulated by the
-// force evaluation of each step; bonds whose energy reached W_cr break at the end of the step's
-// force evaluation, before the velocity update (so the step's accelerations, and the next step's
-// first half of the work, are those of the new bond set), and before the fluid (Algorithm 1).
+// force evaluation of each step; bonds whose energy reached W_cr break at the end of the step,
+// after its velocity update and before the fluid (Algorithm 1); the next step runs with the
+// new bond set (after_breakage).
 #ifndef MUPM_SOLID_SOLVER_HPP
 #define MUPM_SOLID_SOLVER_HPP
 
@@ -87,6 +87,8 @@ class SolidSolver : public Mechanics {
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
     if (breaks()) {
       disc_.bonds.hold_pair_forces(Dim + R);
+      f_old_ = Vectors("mupm::force_before_breakage", p.n_owned, Dim);
+      l_old_ = Vectors("mupm::moment_before_breakage", p.n_owned, R);
       st_.increment = du_;
       if (set_.fracture.effective_state)
         st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
@@ -215,24 +217,47 @@ class SolidSolver : public Mechanics {
     dissipation_ += w[1];
     pore_work_ += w[2];
     bond_energy_released_ += w[4];
-    if (w[3] > 0) {
-      // Bonds broke: K, its inverse and the family volumes change at their ends (and with them
-      // eps, kappa and the forces). The forces of the new bond set drive the velocity update
-      // and open the next step's trapezoids (work and bond energies). The fracture dissipation
-      // is the strain energy the body lost in the breakage, at the same u and theta: in the
-      // correspondence model a point's energy is its family's, not a sum over its bonds, so
-      // the broken bonds' W (what the criterion compares with W_cr, bond_energy_released) is
-      // not what the body loses; the loss is what closes the energy balance (eq 140).
-      disc_.update_shape();
-      st_.work = BondWork::Record;
-      forces(t + dt);
-      keep_applied_pressure();
-      double after = stored_energy();
-      MPI_Allreduce(MPI_IN_PLACE, &after, 1, MPI_DOUBLE, MPI_SUM, comm_);
-      fracture_energy_ += w[5] - after;
-    }
     advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                        set_.damping, dt);
+    if (w[3] > 0)
+      after_breakage(t + dt, w[5]);
+  }
+
+  // Bonds broke at the end of a step (Algorithm 4), after its velocity update: the step ran
+  // with the old bond set, as its work and the bond energies were booked. K, its inverse and
+  // the family volumes change at the broken bonds' ends, and with them eps, kappa and the
+  // forces: the forces of the new bond set replace the old ones in the accelerations (for the
+  // next step's first velocity half) and open the next step's trapezoids (work and bond
+  // energies). The fracture dissipation is the strain energy the body loses in the breakage, at
+  // the same u and theta: in the correspondence model a point's energy is its family's, not a
+  // sum over its bonds, so the broken bonds' W (what the criterion compares with W_cr,
+  // bond_energy_released) is not what the body loses; the loss is what closes the energy
+  // balance (eq 140). `before`: the strain energy of the old bond set (summed over ranks).
+  void after_breakage(double t, double before) {
+    auto& p = disc_.points;
+    Kokkos::deep_copy(f_old_, st_.force);
+    Kokkos::deep_copy(l_old_, st_.moment);
+    disc_.update_shape();
+    st_.work = BondWork::Record;
+    forces(t);
+    keep_applied_pressure();
+    double after = stored_energy();
+    MPI_Allreduce(MPI_IN_PLACE, &after, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    fracture_energy_ += before - after;
+    auto a = p.a, al = p.alpha;
+    auto f = st_.force, l = st_.moment, f0 = f_old_, l0 = l_old_;
+    auto rho = rho_, J = inertia_;
+    auto fixed = p.fixed;
+    Kokkos::parallel_for(
+        "mupm::Fracture::accelerations", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          const std::uint32_t fx = fixed(i);
+          for (int k = 0; k < Dim; ++k)
+            if (!(fx & (1u << k)))
+              a(i, k) += (f(i, k) - f0(i, k)) / rho(i);
+          for (int r = 0; r < R; ++r)
+            if (!(fx & (1u << (Dim + r))))
+              al(i, r) += (l(i, r) - l0(i, r)) / J(i);
+        });
   }
 
   // Strain energy (elastic and stabilization) of this rank's points.
@@ -507,6 +532,7 @@ class SolidSolver : public Mechanics {
   SolidState<Dim> st_;
   Scalars rho_, inertia_;
   Vectors body_, couple_, du_;
+  Vectors f_old_, l_old_;  // forces of the old bond set at a breakage
   Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
   double fracture_energy_ = 0;       // strain energy lost to bond breakage since t = 0 [J]
