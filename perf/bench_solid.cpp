@@ -1,12 +1,15 @@
 // Google Benchmark of the micropolar correspondence kernels on one rank: pass 1 (K, eps, kappa,
 // constitutive update, stabilization Q1/Q2 and energy), pass 2 (force and moment densities) and
 // the whole force evaluation (solid_forces: pass 1, ghost refresh, pass 2), in 2D (400 x 400)
-// and 3D (50^3) at delta = 3.015 dx and 4.015 dx.
+// and 3D (50^3) at delta = 3.015 dx and 4.015 dx; and what bond breakage adds to a step: the
+// force evaluation with the bond-energy accumulation, the breakage scan, the damage update.
 // Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads ./perf/bench_solid
 #include <cmath>
 
 #include "bench_common.hpp"
 #include "mupm/input/model.hpp"
+#include "mupm/kernels/damage.hpp"
+#include "mupm/kernels/fracture.hpp"
 #include "mupm/mesh/discretization.hpp"
 #include "mupm/solvers/solid_solver.hpp"
 
@@ -95,23 +98,61 @@ void BM_SolidForces(benchmark::State& state) {
   set_counters(state, b);
 }
 
+// Bond breakage's share of a step (include/mupm/kernels/fracture.hpp): the force evaluation
+// with the bond energy accumulated in pass 2 (BondWork::Accumulate: the pair states recorded
+// and the trapezoid over a step increment of 1e-3 of the field), then the scan for W >= W_cr
+// (here nothing breaks: the scan's cost) and the damage update (eq 37). Compare with
+// BM_SolidForces of the same grid.
+template <int Dim>
+void BM_SolidForcesWithBreakage(benchmark::State& state) {
+  auto& b = body<Dim>(state);
+  auto& p = b.disc.points;
+  if (b.disc.bonds.pair_width == 0) {
+    b.disc.bonds.hold_pair_forces(Dim + kRotDim<Dim>);
+    b.st.increment = Vectors("increment", p.size(), Dim + kRotDim<Dim>);
+    auto inc = b.st.increment, u = p.u, th = p.theta;
+    Kokkos::parallel_for(
+        "bench::increment", range(0, p.size()), KOKKOS_LAMBDA(const std::size_t i) {
+          for (int d = 0; d < Dim; ++d)
+            inc(i, d) = 1e-3 * u(i, d);
+          for (int r = 0; r < kRotDim<Dim>; ++r)
+            inc(i, Dim + r) = 1e-3 * th(i, r);
+        });
+  }
+  Scalars released("released", p.n_owned);
+  const double w_cr = 1e30;
+  b.st.work = BondWork::Accumulate;
+  for (auto _ : state) {
+    solid_forces(b.disc, b.prm, b.st);
+    break_bonds(p, b.disc.bonds, w_cr, released);
+    compute_damage(b.disc.bonds, p, 0.3);
+    Kokkos::fence();
+  }
+  b.st.work = BondWork::Off;
+  set_counters(state, b);
+}
+
 // Grouped by configuration so that the output reads pass1, pass2, forces for each grid.
 // UseRealTime: Google Benchmark's default clock (and so every rate counter) is the CPU time of
 // the calling thread alone, not the wall time of the parallel region: on a loaded machine the
 // main thread waits off-CPU while the other OpenMP threads finish, and the rates come out up
 // to T times too high.
-#define MUPM_SOLID_BENCH(Dim, n, factor)  \
-  BENCHMARK_TEMPLATE(BM_SolidPass1, Dim)  \
-      ->Args({n, factor})                 \
-      ->Unit(benchmark::kMillisecond)     \
-      ->UseRealTime();                    \
-  BENCHMARK_TEMPLATE(BM_SolidPass2, Dim)  \
-      ->Args({n, factor})                 \
-      ->Unit(benchmark::kMillisecond)     \
-      ->UseRealTime();                    \
-  BENCHMARK_TEMPLATE(BM_SolidForces, Dim) \
-      ->Args({n, factor})                 \
-      ->Unit(benchmark::kMillisecond)     \
+#define MUPM_SOLID_BENCH(Dim, n, factor)              \
+  BENCHMARK_TEMPLATE(BM_SolidPass1, Dim)              \
+      ->Args({n, factor})                             \
+      ->Unit(benchmark::kMillisecond)                 \
+      ->UseRealTime();                                \
+  BENCHMARK_TEMPLATE(BM_SolidPass2, Dim)              \
+      ->Args({n, factor})                             \
+      ->Unit(benchmark::kMillisecond)                 \
+      ->UseRealTime();                                \
+  BENCHMARK_TEMPLATE(BM_SolidForces, Dim)             \
+      ->Args({n, factor})                             \
+      ->Unit(benchmark::kMillisecond)                 \
+      ->UseRealTime();                                \
+  BENCHMARK_TEMPLATE(BM_SolidForcesWithBreakage, Dim) \
+      ->Args({n, factor})                             \
+      ->Unit(benchmark::kMillisecond)                 \
       ->UseRealTime()
 
 MUPM_SOLID_BENCH(2, 400, 3015);

@@ -79,9 +79,13 @@ void region_template(ParameterList& r) {
 }
 void crack_template(ParameterList& c) {
   c.set("Start", Array<double>(), "2D: first end of the crack segment [m].");
-  c.set("End", Array<double>(), "2D: second end of the crack segment [m]: the tip, from which crack_length measures growth.");
+  c.set(
+      "End", Array<double>(),
+      "2D: second end of the crack segment [m]: the tip, from which crack_length measures growth.");
   c.set("Corner", Array<double>(), "3D: a corner of the crack rectangle [m].");
-  c.set("Edge 1", Array<double>(), "3D: first edge vector of the rectangle from Corner [m]: the direction of growth for crack_length (the tip is the far edge).");
+  c.set("Edge 1", Array<double>(),
+        "3D: first edge vector of the rectangle from Corner [m]: the direction of growth for "
+        "crack_length (the tip is the far edge).");
   c.set("Edge 2", Array<double>(),
         "3D: second edge vector of the rectangle from Corner [m], orthogonal to Edge 1.");
 }
@@ -860,8 +864,9 @@ MemoryNeed memory_need_of(const ParameterList& input, int ranks) {
   // 1 KiB in 3D. Per bond: the bond registry (with the pair force states of bond breakage),
   // plus the sort keys of the neighbour build.
   const double per_point = double(Points<Dim>::bytes_per_point()) + (Dim == 2 ? 512 : 1024);
-  const bool breaks = bond_breaking_options()(input.sublist("Fracture").get<std::string>(
-                          "Bond Breakage")) != BondBreaking::None;
+  const bool breaks =
+      bond_breaking_options()(input.sublist("Fracture").get<std::string>("Bond Breakage")) !=
+      BondBreaking::None;
   const double per_bond =
       double(Bonds::bytes_per_bond(breaks ? Dim + kRotDim<Dim> : 0)) + sizeof(GlobalId);
   m.bytes_per_rank = (n + ghosts) * per_point + n * m.bonds_per_point * per_bond;

@@ -38,8 +38,8 @@ const Options<RetentionModel>& retention_model_options() {
   return o;
 }
 const Options<BondBreaking>& bond_breaking_options() {
-  static const Options<BondBreaking> o("Bond Breakage",
-                                       {{"None", BondBreaking::None}, {"Energy", BondBreaking::Energy}});
+  static const Options<BondBreaking> o(
+      "Bond Breakage", {{"None", BondBreaking::None}, {"Energy", BondBreaking::Energy}});
   return o;
 }
 const Options<BondEnergyState>& bond_energy_state_options() {

@@ -246,8 +246,8 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
                           "holds other bonds than this input makes (horizon, pre-cracks or "
                           "grid differ).");
   for_each_checkpointed(disc.bonds, [&](const auto& view, const FieldSpec& s) {
-    std::vector<typename std::decay_t<decltype(view)>::value_type> rows(
-        t.neighbor_gid.size() * std::size_t(s.ncomp));
+    std::vector<typename std::decay_t<decltype(view)>::value_type> rows(t.neighbor_gid.size() *
+                                                                        std::size_t(s.ncomp));
     file.read_points(std::string("bonds/") + s.name, gids, t.width * s.ncomp, rows.data());
     from_table(view, disc.bonds.offsets, n, t.width, rows);
   });

@@ -249,8 +249,7 @@ long long report_discretization(const Discretization<Dim>& disc, const Teuchos::
         << " m, horizon = " << g.horizon << " m (" << g.horizon / g.dx << " dx)\n"
         << "mupm: " << comm.getSize() << " rank(s) x " << ExecSpace().concurrency() << " "
         << ExecSpace::name() << " thread(s); " << Points<Dim>::bytes_per_point()
-        << " bytes per point, " << Bonds::bytes_per_bond(pair_width)
-        << " bytes per bond\n";
+        << " bytes per point, " << Bonds::bytes_per_bond(pair_width) << " bytes per bond\n";
   return counts[0];
 }
 
@@ -384,6 +383,88 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, int rank, std
   }
   return dt;
 }
+
+// Stable steps that follow the state. The estimates of choose_time_step are for the initial
+// state; two changes of the state can shrink them during a run:
+//   - bonds break (the solid's and the fluid's operators change at the broken bonds' ends);
+//   - points wet towards saturation (the storage C falls from phi dS_r/dp to phi S_r/K_w: the
+//     fluid's diffusivity and the pore water's undrained stiffness S_r^2/C grow).
+// After each step this re-estimates both when the broken bond pairs grew by 1 % of all pairs
+// since the last estimate, or the smallest storage fell below half of its value then (both
+// counted the same on every rank, and the estimates rounded to 3 digits, so every rank count
+// takes the same decisions). With Fluid Substeps = 0 the substeps follow the new fluid
+// estimate (automatic sub-cycling); otherwise, and for the solid step, which is fixed, a step
+// beyond Time Step Safety Factor x the new estimate draws a warning naming the step, once per
+// estimate (the divergence check stops a run that then blows up).
+template <int Dim>
+class StableStepWatch {
+ public:
+  StableStepWatch(const RunSettings& run, Assembly<Dim>& ph, long long n_bonds, double dt, int rank,
+                  std::ostream& out)
+      : run_(run), ph_(ph), pairs_(double(n_bonds) / 2), dt_(dt), rank_(rank), out_(out) {
+    solid_ = ph.mechanics && ph.mechanics->limits_time_step() ? ph.mechanics.get() : nullptr;
+    remember();
+  }
+
+  void operator()(long long step, double time) {
+    const bool broke = solid_ && double(solid_->broken_pairs() - pairs_at_) >= 0.01 * pairs_;
+    const bool wetted = ph_.fluid && ph_.fluid->min_storage() < 0.5 * storage_at_;
+    if (!broke && !wetted)
+      return;
+    ScopedRegion region("mupm::Solver::stable_step_update");
+    std::ostringstream why;
+    why << "at step " << step << " (t = " << time << " s), "
+        << (broke ? "after bond breakage" : "after wetting") << ": ";
+    if (solid_) {
+      const double stable = three_digits(solid_->stable_time_step());
+      if (rank_ == 0) {
+        out_ << "mupm: " << why.str() << "estimated stable dt = " << stable << " s\n";
+        if (dt_ > run_.safety * stable)
+          out_ << "mupm: WARNING: " << why.str() << "Time Step = " << dt_
+               << " s exceeds Time Step Safety Factor x the estimated stable step = "
+               << run_.safety * stable << " s: the run may blow up; restart from a checkpoint "
+               << "with a smaller Time Step.\n";
+      }
+    }
+    if (ph_.fluid) {
+      const double stable_f = three_digits(ph_.fluid->estimate_stable_dt());
+      const double interval = ph_.sequence.fluid_every * dt_;
+      if (run_.fluid_substeps == 0) {
+        const double needed = std::ceil(interval / (run_.safety * stable_f) - 1e-9);
+        if (!(needed <= kMaxFluidSubsteps && stable_f > 0))
+          throw CollectiveError(
+              why.str() + too_stiff(ph_.fluid->params(), ph_.spacing, stable_f, interval, needed));
+        ph_.sequence.substeps = std::max(ph_.sequence.substeps, int(needed));
+      }
+      const double dt_f = interval / ph_.sequence.substeps;
+      if (rank_ == 0) {
+        out_ << "mupm: " << why.str() << "estimated stable fluid dt = " << stable_f
+             << " s; fluid dt = " << dt_f << " s (" << ph_.sequence.substeps << " substep(s))\n";
+        if (dt_f > run_.safety * stable_f)
+          out_ << "mupm: WARNING: " << why.str() << "the fluid step " << dt_f
+               << " s exceeds Time Step Safety Factor x the estimated stable fluid step = "
+               << run_.safety * stable_f
+               << " s: the pressure may blow up; use Solver->Fluid Substeps = 0 (automatic).\n";
+      }
+    }
+    remember();
+  }
+
+ private:
+  void remember() {
+    pairs_at_ = solid_ ? solid_->broken_pairs() : 0;
+    storage_at_ = ph_.fluid ? ph_.fluid->min_storage() : 0.0;
+  }
+  const RunSettings& run_;
+  Assembly<Dim>& ph_;
+  Mechanics* solid_ = nullptr;
+  double pairs_;
+  double dt_;
+  int rank_;
+  std::ostream& out_;
+  long long pairs_at_ = 0;
+  double storage_at_ = 0;
+};
 
 // After each step: the energy balances (eqs 140 and 149) against the tolerance, and the
 // primary fields for NaN/Inf. Throws CollectiveError to stop the run.
@@ -625,6 +706,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   // ---------------------------------------------------------------- loop
   const long long first_step = step, last_step = run.n_steps;
   StepChecks<Dim> checks(run, disc, mpi, rank, out);
+  StableStepWatch<Dim> stable_steps(run, ph, n_bonds, dt, rank, out);
   const auto t_loop = Clock::now();
   auto t_last_progress = t_loop;
   while (step < last_step) {
@@ -635,6 +717,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     ++step;
     time += dt;
     checks(ph.modules(), step - first_step, step, time);
+    stable_steps(step, time);
     if (step % run.series_interval == 0 || step == last_step)
       write_series();
     if ((run.field_interval > 0 && step % run.field_interval == 0) || step == last_step)

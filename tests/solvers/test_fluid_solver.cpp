@@ -203,9 +203,10 @@ TEST(FluidSolver, PointSourceBalanceWithoutFalseAlarm) {
   }
   p_well_end = pressure_at_well();
   if (test::world()->getRank() == 0)
-    std::printf("[ source ] well pressure %.4g -> %.4g Pa; largest balance error / largest term "
-                "after step 20: %.2e\n",
-                p_well_start, p_well_end, worst);
+    std::printf(
+        "[ source ] well pressure %.4g -> %.4g Pa; largest balance error / largest term "
+        "after step 20: %.2e\n",
+        p_well_start, p_well_end, worst);
   EXPECT_GT(p_well_end - p_well_start, 5e3);  // the source does change the state
   EXPECT_LT(worst, 2e-3);
 }

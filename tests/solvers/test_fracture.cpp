@@ -199,8 +199,7 @@ double lattice_to_continuum(double factor) {
           const double d2 = double(a * a + b * b + (k + m - 1) * (k + m - 1));
           c += within_horizon(d2, factor * factor) ? 1 : 0;
         }
-  const double continuum =
-      Dim == 2 ? 2 * std::pow(factor, 3) / 3 : kPi * std::pow(factor, 4) / 4;
+  const double continuum = Dim == 2 ? 2 * std::pow(factor, 3) / 3 : kPi * std::pow(factor, 4) / 4;
   return double(c) / continuum;
 }
 
@@ -211,7 +210,8 @@ void expect_energy_release(const Opening& o, double factor) {
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   if (rank == 0)
-    std::printf("released/G_cr = %.5f, lattice pairs/continuum = %.5f, breaks in steps %d..%d\n", ratio, lattice, o.first_break_step, o.last_break_step);
+    std::printf("released/G_cr = %.5f, lattice pairs/continuum = %.5f, breaks in steps %d..%d\n",
+                ratio, lattice, o.first_break_step, o.last_break_step);
   ::testing::Test::RecordProperty("released_over_Gcr", std::to_string(ratio));
   ::testing::Test::RecordProperty("lattice_pairs_over_continuum", std::to_string(lattice));
   // Every crossing bond broke, and nothing else.

@@ -67,8 +67,8 @@ struct Points {
   Scalars undrained_modulus;  // S_r / C [Pa]: dp = -(S_r/C) d(tr eps) at fixed water content;
                               // 0 where p is prescribed or without a fluid (undrained split)
   // Fracture.
-  Scalars damage;  // D_i (eq 37)
-  Bytes fracture;  // 1: fracture point (D >= D_cr or next to a pre-crack)
+  Scalars damage;                // D_i (eq 37)
+  Bytes fracture;                // 1: fracture point (D >= D_cr or next to a pre-crack)
   Scalars bond_energy_released;  // energy released by the point's broken bonds [J], half of
                                  // W V_i V_j per bond (the other half is at the other end)
   // Constitutive state: effective stress, couple stress, equivalent plastic strain.

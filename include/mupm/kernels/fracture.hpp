@@ -34,7 +34,7 @@ enum class BondBreaking { None, Energy };
 
 struct FractureParams {
   BondBreaking criterion = BondBreaking::None;
-  double critical_energy = 0;  // W_cr per pair of unit volumes [J/m^6]
+  double critical_energy = 0;    // W_cr per pair of unit volumes [J/m^6]
   double critical_damage = 0.3;  // D_cr: fracture point at D >= D_cr (eq 104)
   bool effective_state = true;   // bond energy of the effective (true) or total force state
 };

@@ -344,7 +344,8 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
                 t[a] += wi + wj;
               }
             if (accumulate) {
-              // dU^ = d(u_j - u_i) - (d theta_i + d theta_j)/2 x xi, dOmega = d theta_j - d theta_i.
+              // dU^ = d(u_j - u_i) - (d theta_i + d theta_j)/2 x xi, dOmega = d theta_j - d
+              // theta_i.
               double tb[R], c[Dim], dw = 0;
               for (int r = 0; r < R; ++r)
                 tb[r] = 0.5 * (inc(i, Dim + r) + inc(j, Dim + r));

@@ -221,6 +221,19 @@ class FluidSolver : public Module {
     return s;
   }
 
+  // Smallest storage C over the points (free or not) [1/Pa]: it falls as points wet towards
+  // saturation, and with it the stable steps.
+  double min_storage() const {
+    auto C = st_.storage;
+    double m = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::min_storage", range(0, disc_.points.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc = C(i) < acc ? C(i) : acc; },
+        Kokkos::Min<double>(m));
+    MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MIN, comm_);
+    return m;
+  }
+
   // Largest S_r^2 / C over the points: the pore water's contribution to the undrained bulk
   // modulus (K_w / phi when saturated), for the solid's stable step.
   double undrained_stiffening() const {

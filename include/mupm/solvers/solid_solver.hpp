@@ -56,7 +56,7 @@ class SolidSolver : public Mechanics {
   };
   struct Energy {
     double internal = 0, kinetic = 0, external_work = 0, dissipation = 0;
-    double fracture = 0;  // strain energy lost when bonds broke (fracture dissipation)
+    double fracture = 0;     // strain energy lost when bonds broke (fracture dissipation)
     double bond_energy = 0;  // sum of W V_i V_j of the broken bonds (the criterion's energy)
     // Work of the pore water on the skeleton: sum over steps of sum_i V_i S_r p* d(tr eps_i)
     // (the -S_r p* 1 part of the total stress, eq 46; p* linear in tr eps within a step, so the
@@ -67,8 +67,9 @@ class SolidSolver : public Mechanics {
       return internal + kinetic + dissipation + fracture - external_work - pore_work;
     }
     double scale() const {
-      return std::max(std::max(std::max(std::abs(internal), kinetic), fracture),
-                      std::max(std::max(std::abs(external_work), dissipation), std::abs(pore_work)));
+      return std::max(
+          std::max(std::max(std::abs(internal), kinetic), fracture),
+          std::max(std::max(std::abs(external_work), dissipation), std::abs(pore_work)));
     }
   };
 
@@ -135,8 +136,8 @@ class SolidSolver : public Mechanics {
     const auto e = energy();
     EnergyBalance b;
     b.what = "solid";
-    b.expression =
-        breaks() ? "E_int + E_kin + D + D_frac - W_ext - W_pore - E_0" : "E_int + E_kin + D - W_ext - W_pore - E_0";
+    b.expression = breaks() ? "E_int + E_kin + D + D_frac - W_ext - W_pore - E_0"
+                            : "E_int + E_kin + D - W_ext - W_pore - E_0";
     b.error = std::abs(e.balance() - balance0_);
     b.scale = e.scale();
     b.stored_expression = "E_int + E_kin";
@@ -219,9 +220,12 @@ class SolidSolver : public Mechanics {
     bond_energy_released_ += w[4];
     advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                        set_.damping, dt);
-    if (w[3] > 0)
+    if (w[3] > 0) {
       after_breakage(t + dt, w[5]);
+      broken_pairs_ += (long long)(w[3]) / 2;
+    }
   }
+  long long broken_pairs() const override { return broken_pairs_; }
 
   // Bonds broke at the end of a step (Algorithm 4), after its velocity update: the step ran
   // with the old bond set, as its work and the bond energies were booked. K, its inverse and
@@ -537,6 +541,7 @@ class SolidSolver : public Mechanics {
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
   double fracture_energy_ = 0;       // strain energy lost to bond breakage since t = 0 [J]
   double bond_energy_released_ = 0;  // W V_i V_j of the bonds broken since t = 0 [J]
+  long long broken_pairs_ = 0;       // bond pairs broken since the start or restart
 };
 
 }  // namespace mupm
