@@ -170,6 +170,13 @@ struct Assembly {
   std::unique_ptr<Damage<Dim>> damage;
   StepSequence<Dim> sequence;
   double spacing = 0;  // dx, for messages
+  // The stable-step watch's state (StableStepWatch), kept across a restart so that a restarted
+  // run re-estimates at the same steps and keeps the fluid substeps of the straight run.
+  struct Watch {
+    double pairs_at = 0;    // broken pairs at the last estimate
+    double storage_at = 0;  // smallest storage C at the last estimate [1/Pa]
+    double substeps = 0;    // fluid substeps in use (0: not set yet)
+  } watch;
   // Time series, restart globals and energy balances, in the time series' column order.
   std::vector<Module*> modules() const {
     std::vector<Module*> m{damage.get()};
@@ -190,7 +197,7 @@ struct Assembly {
         fluid->reset_strain_reference();
     }
   }
-  NamedGlobals globals() const {
+  NamedGlobals globals() {
     NamedGlobals out;
     for (Module* m : modules()) {
       GlobalRefs g;
@@ -198,6 +205,9 @@ struct Assembly {
       for (const auto& [name, ptr] : g.refs())
         out.push_back({std::string(m->name()) + "/" + name, ptr});
     }
+    out.push_back({"stable_steps/broken_pairs_at_estimate", &watch.pairs_at});
+    out.push_back({"stable_steps/min_storage_at_estimate", &watch.storage_at});
+    out.push_back({"stable_steps/fluid_substeps", &watch.substeps});
     return out;
   }
 };
@@ -328,7 +338,8 @@ void restart(const RunSettings& run, Discretization<Dim>& disc, long long& step,
 // The time step and the fluid's substeps from the modules' stable-step estimates (Automatic
 // Time Step, Fluid Substeps = 0), with warnings where the given ones exceed them.
 template <int Dim>
-double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, int rank, std::ostream& out) {
+double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarted, int rank,
+                        std::ostream& out) {
   const double safety = run.safety;
   double dt = run.time_step;
   Mechanics* solid =
@@ -365,7 +376,11 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, int rank, std
         throw InputError(too_stiff(fluid.params(), ph.spacing, stable_f, interval, needed));
       substeps = std::max(1, int(needed));
     }
+    // A restart continues with the substeps the run had reached (StableStepWatch).
+    if (restarted && ph.watch.substeps > 0)
+      substeps = int(ph.watch.substeps);
     ph.sequence.substeps = substeps;
+    ph.watch.substeps = substeps;
     const double dt_f = interval / substeps;
     if (rank == 0) {
       out << "mupm: pore fluid, k/mu_w = " << fluid.params().mobility
@@ -399,16 +414,18 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, int rank, std
 template <int Dim>
 class StableStepWatch {
  public:
-  StableStepWatch(const RunSettings& run, Assembly<Dim>& ph, long long n_bonds, double dt, int rank,
-                  std::ostream& out)
+  StableStepWatch(const RunSettings& run, Assembly<Dim>& ph, long long n_bonds, double dt,
+                  bool restarted, int rank, std::ostream& out)
       : run_(run), ph_(ph), pairs_(double(n_bonds) / 2), dt_(dt), rank_(rank), out_(out) {
     solid_ = ph.mechanics && ph.mechanics->limits_time_step() ? ph.mechanics.get() : nullptr;
-    remember();
+    if (!restarted)  // a restart has the state of the run it continues (Assembly::watch)
+      remember();
   }
 
   void operator()(long long step, double time) {
-    const bool broke = solid_ && double(solid_->broken_pairs() - pairs_at_) >= 0.01 * pairs_;
-    const bool wetted = ph_.fluid && ph_.fluid->min_storage() < 0.5 * storage_at_;
+    const bool broke =
+        solid_ && double(solid_->broken_pairs()) - ph_.watch.pairs_at >= 0.01 * pairs_;
+    const bool wetted = ph_.fluid && ph_.fluid->min_storage() < 0.5 * ph_.watch.storage_at;
     if (!broke && !wetted)
       return;
     ScopedRegion region("mupm::Solver::stable_step_update");
@@ -435,6 +452,7 @@ class StableStepWatch {
           throw CollectiveError(
               why.str() + too_stiff(ph_.fluid->params(), ph_.spacing, stable_f, interval, needed));
         ph_.sequence.substeps = std::max(ph_.sequence.substeps, int(needed));
+        ph_.watch.substeps = ph_.sequence.substeps;
       }
       const double dt_f = interval / ph_.sequence.substeps;
       if (rank_ == 0) {
@@ -452,8 +470,8 @@ class StableStepWatch {
 
  private:
   void remember() {
-    pairs_at_ = solid_ ? solid_->broken_pairs() : 0;
-    storage_at_ = ph_.fluid ? ph_.fluid->min_storage() : 0.0;
+    ph_.watch.pairs_at = solid_ ? double(solid_->broken_pairs()) : 0.0;
+    ph_.watch.storage_at = ph_.fluid ? ph_.fluid->min_storage() : 0.0;
   }
   const RunSettings& run_;
   Assembly<Dim>& ph_;
@@ -462,8 +480,6 @@ class StableStepWatch {
   double dt_;
   int rank_;
   std::ostream& out_;
-  long long pairs_at_ = 0;
-  double storage_at_ = 0;
 };
 
 // After each step: the energy balances (eqs 140 and 149) against the tolerance, and the
@@ -675,7 +691,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   ph.damage->update();
   disc.dist.refresh(pts.double_fields(kGhosted));
   ph.initialize(time, restarted);
-  const double dt = choose_time_step(run, ph, rank, out);
+  const double dt = choose_time_step(run, ph, restarted, rank, out);
 
   FieldOutput<Dim> fields(run.folder, disc, run.fields, history);
   std::unique_ptr<io::CsvWriter> csv;
@@ -706,7 +722,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   // ---------------------------------------------------------------- loop
   const long long first_step = step, last_step = run.n_steps;
   StepChecks<Dim> checks(run, disc, mpi, rank, out);
-  StableStepWatch<Dim> stable_steps(run, ph, n_bonds, dt, rank, out);
+  StableStepWatch<Dim> stable_steps(run, ph, n_bonds, dt, restarted, rank, out);
   const auto t_loop = Clock::now();
   auto t_last_progress = t_loop;
   while (step < last_step) {

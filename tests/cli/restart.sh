@@ -63,7 +63,7 @@ with h5py.File(f"{name}-straight/checkpoint.h5") as a, h5py.File(f"{name}-second
         assert np.allclose(ga[k], gb[k], rtol=1e-11, atol=1e-300), (k, ga[k], gb[k])
 PY
 }
-check solid inputs/quickstart.xml 40 4
-check coupled inputs/consolidation.xml 60 10
-check fracture tests/cli/fracture_small.xml 440 6
+check solid inputs/quickstart.xml 40 7
+check coupled inputs/consolidation.xml 60 13
+check fracture tests/cli/fracture_small.xml 440 10
 echo "restart: passed"

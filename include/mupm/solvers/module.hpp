@@ -77,7 +77,7 @@ class Mechanics : public Module {
   virtual std::string describe() const { return name(); }
   // Mixture density and micro-inertia after the fluid changed the saturation (eq 1).
   virtual void update_density() {}
-  // Bond pairs broken since the run started or restarted (the same number on every rank).
+  // Bond pairs broken since t = 0 (the same number on every rank).
   virtual long long broken_pairs() const { return 0; }
 };
 

@@ -113,6 +113,8 @@ class SolidSolver : public Mechanics {
       g("fracture_energy", fracture_energy_);
     if (breaks())
       g("bond_energy_released", bond_energy_released_);
+    if (breaks())
+      g("broken_pairs", broken_pairs_);
   }
   void series(SeriesRow& row) const override {
     const auto e = energy();
@@ -222,10 +224,10 @@ class SolidSolver : public Mechanics {
                        set_.damping, dt);
     if (w[3] > 0) {
       after_breakage(t + dt, w[5]);
-      broken_pairs_ += (long long)(w[3]) / 2;
+      broken_pairs_ += w[3] / 2;
     }
   }
-  long long broken_pairs() const override { return broken_pairs_; }
+  long long broken_pairs() const override { return (long long)broken_pairs_; }
 
   // Bonds broke at the end of a step (Algorithm 4), after its velocity update: the step ran
   // with the old bond set, as its work and the bond energies were booked. K, its inverse and
@@ -541,7 +543,7 @@ class SolidSolver : public Mechanics {
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
   double fracture_energy_ = 0;       // strain energy lost to bond breakage since t = 0 [J]
   double bond_energy_released_ = 0;  // W V_i V_j of the bonds broken since t = 0 [J]
-  long long broken_pairs_ = 0;       // bond pairs broken since the start or restart
+  double broken_pairs_ = 0;          // bond pairs broken since t = 0 (a restart global)
 };
 
 }  // namespace mupm
