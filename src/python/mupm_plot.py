@@ -5,6 +5,11 @@
       2D point field (last output step by default) on the deformed points (scale S).
   mupm_plot.py series OUTPUT_DIR COLUMN [COLUMN...] [-o out.png]
       columns of time_series.csv against time.
+  mupm_plot.py compare COLUMN OUTPUT_DIR[:LABEL] [OUTPUT_DIR[:LABEL] ...] [--time-scale S]
+                       [--xlabel TEXT] [--reference X Y [X Y ...]] [--reference-label TEXT]
+                       [-o out.png]
+      one column of several runs against time x S (e.g. the load of a ramp), with reference
+      points (X, Y) such as a paper's values.
 """
 import argparse
 import csv
@@ -69,6 +74,27 @@ def plot_series(args):
     print("wrote", args.output)
 
 
+def plot_compare(args):
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for run in args.runs:
+        d, _, label = run.partition(":")
+        rows = list(csv.DictReader(open(os.path.join(d, "time_series.csv"))))
+        if args.column not in rows[0]:
+            raise SystemExit("%s: no column %s in time_series.csv" % (d, args.column))
+        ax.plot([float(r["time"]) * args.time_scale for r in rows],
+                [float(r[args.column]) for r in rows], label=label or d)
+    if args.reference:
+        if len(args.reference) % 2:
+            raise SystemExit("--reference takes pairs X Y")
+        ax.plot(args.reference[0::2], args.reference[1::2], "ko", label=args.reference_label)
+    ax.set_xlabel(args.xlabel)
+    ax.set_ylabel(args.column)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.savefig(args.output, dpi=150, bbox_inches="tight")
+    print("wrote", args.output)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -83,8 +109,16 @@ def main():
     s.add_argument("dir")
     s.add_argument("columns", nargs="+")
     s.add_argument("-o", "--output", default="series.png")
+    c = sub.add_parser("compare")
+    c.add_argument("column")
+    c.add_argument("runs", nargs="+", metavar="OUTPUT_DIR[:LABEL]")
+    c.add_argument("--time-scale", type=float, default=1.0)
+    c.add_argument("--xlabel", default="time [s]")
+    c.add_argument("--reference", type=float, nargs="+")
+    c.add_argument("--reference-label", default="reference")
+    c.add_argument("-o", "--output", default="compare.png")
     args = p.parse_args()
-    plot_field(args) if args.cmd == "field" else plot_series(args)
+    {"field": plot_field, "series": plot_series, "compare": plot_compare}[args.cmd](args)
 
 
 if __name__ == "__main__":
