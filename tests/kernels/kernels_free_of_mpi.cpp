@@ -4,6 +4,7 @@
 #include "mupm/kernels/central_difference.hpp"
 #include "mupm/kernels/damage.hpp"
 #include "mupm/kernels/fluid.hpp"
+#include "mupm/kernels/fracture.hpp"
 #include "mupm/kernels/shape_tensor.hpp"
 #include "mupm/kernels/solid.hpp"
 #include "mupm/laws/micropolar_elastic.hpp"
