@@ -8,7 +8,6 @@
 
 #include "bench_common.hpp"
 #include "mupm/input/model.hpp"
-#include "mupm/kernels/damage.hpp"
 #include "mupm/kernels/fracture.hpp"
 #include "mupm/mesh/discretization.hpp"
 #include "mupm/solvers/solid_solver.hpp"
@@ -101,8 +100,9 @@ void BM_SolidForces(benchmark::State& state) {
 // Bond breakage's share of a step (include/mupm/kernels/fracture.hpp): the force evaluation
 // with the bond energy accumulated in pass 2 (BondWork::Accumulate: the pair states recorded
 // and the trapezoid over a step increment of 1e-3 of the field), then the scan for W >= W_cr
-// (here nothing breaks: the scan's cost) and the damage update (eq 37). Compare with
-// BM_SolidForces of the same grid.
+// (here nothing breaks: the scan's cost, a point loop over the largest W of each family).
+// Steps that break nothing update no damage (StepSequence). Compare with BM_SolidForces of the
+// same grid.
 template <int Dim>
 void BM_SolidForcesWithBreakage(benchmark::State& state) {
   auto& b = body<Dim>(state);
@@ -110,6 +110,7 @@ void BM_SolidForcesWithBreakage(benchmark::State& state) {
   if (b.disc.bonds.pair_width == 0) {
     b.disc.bonds.hold_pair_forces(Dim + kRotDim<Dim>);
     b.st.increment = Vectors("increment", p.size(), Dim + kRotDim<Dim>);
+    b.st.max_energy = Scalars("max_energy", p.n_owned);
     auto inc = b.st.increment, u = p.u, th = p.theta;
     Kokkos::parallel_for(
         "bench::increment", range(0, p.size()), KOKKOS_LAMBDA(const std::size_t i) {
@@ -124,8 +125,7 @@ void BM_SolidForcesWithBreakage(benchmark::State& state) {
   b.st.work = BondWork::Accumulate;
   for (auto _ : state) {
     solid_forces(b.disc, b.prm, b.st);
-    break_bonds(p, b.disc.bonds, w_cr, released);
-    compute_damage(b.disc.bonds, p, 0.3);
+    break_bonds(p, b.disc.bonds, w_cr, b.st.max_energy, released);
     Kokkos::fence();
   }
   b.st.work = BondWork::Off;

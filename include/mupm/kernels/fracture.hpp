@@ -55,19 +55,23 @@ struct Breakage {
 
 // Breaks the intact bonds of the owned points whose W reached w_cr (eq 35) and adds the energy
 // they release to released(i) [J]. Both copies of a bond hold the same W (solid pass 2), so
-// both break in the same call, whichever ranks own the two ends.
+// both break in the same call, whichever ranks own the two ends. max_energy(i): the largest W
+// of point i's intact bonds (solid pass 2): points below w_cr are skipped without a bond loop.
 template <int Dim>
 Breakage break_bonds(const Points<Dim>& pts, const Bonds& bonds, double w_cr,
-                     const Scalars& released) {
+                     const Scalars& max_energy, const Scalars& released) {
   auto offsets = bonds.offsets;
   auto neighbor = bonds.neighbor;
   auto intact = bonds.intact;
   auto W = bonds.energy;
   auto vol = pts.volume;
+  auto wmax = max_energy;
   Breakage out;
   Kokkos::parallel_reduce(
       "mupm::Fracture::break_bonds", range(0, pts.n_owned),
       KOKKOS_LAMBDA(const std::size_t i, long long& n, double& e) {
+        if (!(wmax(i) >= w_cr))
+          return;
         double ei = 0;
         for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
           if (!intact(b) || !(W(b) >= w_cr))

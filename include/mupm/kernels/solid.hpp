@@ -80,6 +80,7 @@ struct SolidState {
   BondWork work = BondWork::Off;
   Vectors increment;
   Vectors P1w;
+  Scalars max_energy;  // largest W of the point's intact bonds after Accumulate [n_owned]
 
   void allocate(std::size_t n_all, std::size_t n_owned) {
     eps = Vectors("mupm::eps", n_all, Dim * Dim);
@@ -282,7 +283,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   auto x = pts.x, u = pts.u, th = pts.theta;
   auto vol = pts.volume;
   auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, w0 = st.w0;
-  auto inc = st.increment, P1w = st.P1w;
+  auto inc = st.increment, P1w = st.P1w, wmax = st.max_energy;
   auto force = st.force, moment = st.moment;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
   const double c2 = prm.stabilization * prm.stab_modulus;
@@ -291,7 +292,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   const bool effective = P1w.extent(0) > 0;
   Kokkos::parallel_for(
       "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-        double f[Dim] = {}, l[R] = {};
+        double f[Dim] = {}, l[R] = {}, wm = 0;
         for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
           if (!intact(b))
             continue;
@@ -355,6 +356,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
               for (int r = 0; r < R; ++r)
                 dw += 0.5 * (pair(b, Dim + r) + m[r]) * (inc(j, Dim + r) - inc(i, Dim + r));
               W(b) += dw;
+              wm = W(b) > wm ? W(b) : wm;
             }
             for (int a = 0; a < Dim; ++a)
               pair(b, a) = t[a];
@@ -366,6 +368,8 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           force(i, d) = f[d];
         for (int r = 0; r < R; ++r)
           moment(i, r) = l[r];
+        if (accumulate)
+          wmax(i) = wm;
       });
 }
 

@@ -91,6 +91,7 @@ class SolidSolver : public Mechanics {
       f_old_ = Vectors("mupm::force_before_breakage", p.n_owned, Dim);
       l_old_ = Vectors("mupm::moment_before_breakage", p.n_owned, R);
       st_.increment = du_;
+      st_.max_energy = Scalars("mupm::max_bond_energy", p.n_owned);
       if (set_.fracture.effective_state)
         st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
     }
@@ -210,7 +211,8 @@ class SolidSolver : public Mechanics {
     keep_applied_pressure();
     if (breaks()) {
       const Breakage br =
-          break_bonds(p, disc_.bonds, set_.fracture.critical_energy, p.bond_energy_released);
+          break_bonds(p, disc_.bonds, set_.fracture.critical_energy, st_.max_energy,
+                      p.bond_energy_released);
       w[3] = double(br.bonds);
       w[4] = br.energy;
       w[5] = stored_energy();

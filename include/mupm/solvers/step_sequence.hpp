@@ -25,6 +25,7 @@ struct StepSequence {
   bool fluid_first = false;
   int fluid_every = 1;
   int substeps = 1;
+  long long damage_seen = -1;  // broken bond pairs at the last damage update (bookkeeping)
 
   // Step number `step` (0-based, counted from t = 0 so restarts keep the intervals), t -> t + dt.
   void step(long long step, double t, double dt) {
@@ -33,8 +34,11 @@ struct StepSequence {
       advance_fluid(t, interval);
     if (mechanics)
       mechanics->step(t, dt);
-    if (damage)
+    // Damage changes only where bonds broke (the pre-cracks' is computed at the start).
+    if (damage && mechanics && mechanics->broken_pairs() != damage_seen) {
       damage->update();
+      damage_seen = mechanics->broken_pairs();
+    }
     // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
     if (fluid && !fluid_first && (step + 1) % fluid_every == 0)
       advance_fluid(mechanics ? t + dt - interval : t, interval);
