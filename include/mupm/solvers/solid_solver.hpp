@@ -92,8 +92,6 @@ class SolidSolver : public Mechanics {
       l_old_ = Vectors("mupm::moment_before_breakage", p.n_owned, R);
       st_.increment = du_;
       st_.max_energy = Scalars("mupm::max_bond_energy", p.n_owned);
-      if (set_.fracture.effective_state)
-        st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
     }
   }
   bool breaks() const { return set_.fracture.criterion != BondBreaking::None; }
@@ -171,6 +169,10 @@ class SolidSolver : public Mechanics {
     auto& p = disc_.points;
     mark_fixed(bcs_, p);
     update_density();
+    // The effective force state's bond energy needs the pore-water part of P1 apart, where
+    // there is pore water pressure: a fluid (undrained modulus set), or a held initial pressure.
+    if (breaks() && set_.fracture.effective_state && st_.P1w.extent(0) == 0 && has_pressure())
+      st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
     if (!restarted)
       apply_kinematic(bcs_, p, t, 0.0);
     disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
@@ -266,6 +268,21 @@ class SolidSolver : public Mechanics {
             if (!(fx & (1u << (Dim + r))))
               al(i, r) += (l(i, r) - l0(i, r)) / J(i);
         });
+  }
+
+  // Whether any point has a pore pressure or an undrained modulus (the same on every rank).
+  bool has_pressure() const {
+    const auto& p = disc_.points;
+    auto pw = p.p, bu = p.undrained_modulus;
+    int any = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::has_pressure", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, int& acc) {
+          acc = (pw(i) != 0 || bu(i) != 0) ? 1 : acc;
+        },
+        Kokkos::Max<int>(any));
+    MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, comm_);
+    return any != 0;
   }
 
   // Strain energy (elastic and stabilization) of this rank's points.
