@@ -212,9 +212,8 @@ class SolidSolver : public Mechanics {
     w[2] = pore_power();
     keep_applied_pressure();
     if (breaks()) {
-      const Breakage br =
-          break_bonds(p, disc_.bonds, set_.fracture.critical_energy, st_.max_energy,
-                      p.bond_energy_released);
+      const Breakage br = break_bonds(p, disc_.bonds, set_.fracture.critical_energy, st_.max_energy,
+                                      p.bond_energy_released);
       w[3] = double(br.bonds);
       w[4] = br.energy;
       w[5] = stored_energy();
@@ -243,13 +242,28 @@ class SolidSolver : public Mechanics {
   // sum over its bonds, so the broken bonds' W (what the criterion compares with W_cr,
   // bond_energy_released) is not what the body loses; the loss is what closes the energy
   // balance (eq 140). `before`: the strain energy of the old bond set (summed over ranks).
+  //
+  // With pore water, tr(eps) of the points that lost bonds jumps with their shape tensors at
+  // fixed u: no volume change of the skeleton, so the water must not see one. Their
+  // volumetric-strain reference (of the undrained split and the fluid's next volume change)
+  // moves by the jump, and the forces are evaluated again with it (p* continuous).
   void after_breakage(double t, double before) {
     auto& p = disc_.points;
     Kokkos::deep_copy(f_old_, st_.force);
     Kokkos::deep_copy(l_old_, st_.moment);
+    const auto owned = std::make_pair(std::size_t(0), p.n_owned);
+    Kokkos::deep_copy(vs_old_, Kokkos::subview(p.vol_strain, owned));
     disc_.update_shape();
     st_.work = BondWork::Record;
     forces(t);
+    if (has_pressure()) {
+      auto ref = p.vol_strain_ref, vs = p.vol_strain;
+      auto old = vs_old_;
+      Kokkos::parallel_for(
+          "mupm::Fracture::strain_reference", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i) { ref(i) += vs(i) - old(i); });
+      forces(t);
+    }
     keep_applied_pressure();
     double after = stored_energy();
     MPI_Allreduce(MPI_IN_PLACE, &after, 1, MPI_DOUBLE, MPI_SUM, comm_);
