@@ -176,6 +176,9 @@ class FluidSolver : public Module {
     evaluate();
   }
 
+  // The bond set changed (fracture): the flow of the current pressure again.
+  void bonds_changed() { evaluate(); }
+
   void reset_strain_reference() {
     auto& p = disc_.points;
     Kokkos::deep_copy(Kokkos::subview(p.vol_strain_ref, std::make_pair(std::size_t(0), p.n_owned)),

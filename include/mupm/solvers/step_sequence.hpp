@@ -34,9 +34,12 @@ struct StepSequence {
       advance_fluid(t, interval);
     if (mechanics)
       mechanics->step(t, dt);
-    // Damage changes only where bonds broke (the pre-cracks' is computed at the start).
+    // Bonds broke in the mechanics step: the damage changes (the pre-cracks' is computed at
+    // the start), and so does the fluid's flow of the current pressure (K^-1 and the families).
     if (damage && mechanics && mechanics->broken_pairs() != damage_seen) {
       damage->update();
+      if (fluid && mechanics->broken_pairs() > 0)
+        fluid->bonds_changed();
       damage_seen = mechanics->broken_pairs();
     }
     // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
