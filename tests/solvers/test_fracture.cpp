@@ -247,7 +247,7 @@ TEST(Fracture, StraightCrackReleasesGcr2D) {
 
 TEST(Fracture, StraightCrackReleasesGcr3D) {
   const double factor = 3.05;
-  const Opening o = open_crack<3>({12, 10, 12}, factor, 1e-4, 1000);
+  const Opening o = open_crack<3>({12, 10, 12}, factor, 1e-4, 500);
   expect_energy_release<3>(o, factor);
 }
 

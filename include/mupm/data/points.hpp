@@ -64,6 +64,8 @@ struct Points {
   Scalars fluid_content;      // water volume per unit volume, phi S_r (1 + p/K_w) at t = 0 plus
                               // the increments C dp + S_r d(tr eps) of every fluid step
   Scalars solid_pressure;     // p* of the forces the solid last applied (undrained split)
+  Vectors applied_force;      // force density f of the forces the solid last applied [n][Dim]
+  Vectors applied_moment;     // moment density of the forces the solid last applied [n][RotDim]
   Scalars undrained_modulus;  // S_r / C [Pa]: dp = -(S_r/C) d(tr eps) at fixed water content;
                               // 0 where p is prescribed or without a fluid (undrained split)
   // Fracture.
@@ -165,6 +167,8 @@ struct Points {
     f(p.vol_strain_ref,    FieldSpec{"volumetric_strain_reference", 1, kCheckpoint});
     f(p.fluid_content,     FieldSpec{"fluid_content", 1, kState});
     f(p.solid_pressure,    FieldSpec{"solid_pressure", 1, kCheckpoint});
+    f(p.applied_force,     FieldSpec{"applied_force", D, kCheckpoint});
+    f(p.applied_moment,    FieldSpec{"applied_moment", R, kCheckpoint});
     f(p.undrained_modulus, FieldSpec{"undrained_modulus", 1, 0});
     f(p.damage,            FieldSpec{"damage", 1, kState | kGhosted});
     f(p.fracture,          FieldSpec{"fracture", 1, kState});

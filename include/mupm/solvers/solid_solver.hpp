@@ -176,15 +176,19 @@ class SolidSolver : public Mechanics {
     if (!restarted)
       apply_kinematic(bcs_, p, t, 0.0);
     disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
-    // The pair force states of this state start the bond energies' trapezoid (a restart's
-    // checkpoint holds the same numbers).
-    st_.work = breaks() ? BondWork::Record : BondWork::Off;
+    // The pair force states of this state start the bond energies' trapezoid. A restart keeps
+    // the checkpoint's: they are the states the forces had when applied, with the pore pressure
+    // of before the step's fluid update (Solid First), which the forces evaluated here no
+    // longer have.
+    st_.work = breaks() && !restarted ? BondWork::Record : BondWork::Off;
     forces(t);
     // Points::solid_pressure is the p* of the forces last applied (the pore work of the next
     // step starts from it); a restart has it from the checkpoint, not from the pressure the
     // fluid has updated since.
+    if (restarted)  // the forces the run applied last, not those of the updated pressure
+      restore_applied();
     if (!restarted) {
-      keep_applied_pressure();
+      keep_applied();
       advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                          0.0, 0.0);
       balance0_ = energy().balance();
@@ -210,7 +214,7 @@ class SolidSolver : public Mechanics {
     w[0] += 0.5 * power();  // new forces (second half)
     w[1] = dt * damping_power();
     w[2] = pore_power();
-    keep_applied_pressure();
+    keep_applied();
     if (breaks()) {
       const Breakage br = break_bonds(p, disc_.bonds, set_.fracture.critical_energy, st_.max_energy,
                                       p.bond_energy_released);
@@ -264,7 +268,7 @@ class SolidSolver : public Mechanics {
           KOKKOS_LAMBDA(const std::size_t i) { ref(i) += vs(i) - old(i); });
       forces(t);
     }
-    keep_applied_pressure();
+    keep_applied();
     double after = stored_energy();
     MPI_Allreduce(MPI_IN_PLACE, &after, 1, MPI_DOUBLE, MPI_SUM, comm_);
     fracture_energy_ += before - after;
@@ -419,6 +423,9 @@ class SolidSolver : public Mechanics {
     disc_.dist.refresh({p.u, p.theta});
     solid_forces(disc_, prm_, law_, st_);
     st_.work = work;
+    // The forces the run applied last, not those of the pressure the fluid has updated since
+    // (the next step's external work starts from them).
+    restore_applied();
     return lambda > 0 ? 2.0 / std::sqrt(lambda) : 0.0;
   }
 
@@ -467,10 +474,21 @@ class SolidSolver : public Mechanics {
         });
   }
 
-  void keep_applied_pressure() {
+  // The p* and the force and moment densities of the forces just applied, into the points'
+  // checkpointed fields: the next step's pore work and external work start from them, also
+  // after a restart (whose fluid has updated p since they were applied).
+  void keep_applied() {
     auto& p = disc_.points;
-    Kokkos::deep_copy(Kokkos::subview(p.solid_pressure, std::make_pair(std::size_t(0), p.n_owned)),
-                      st_.pstar);
+    const auto owned = std::make_pair(std::size_t(0), p.n_owned);
+    Kokkos::deep_copy(Kokkos::subview(p.solid_pressure, owned), st_.pstar);
+    Kokkos::deep_copy(Kokkos::subview(p.applied_force, owned, Kokkos::ALL), st_.force);
+    Kokkos::deep_copy(Kokkos::subview(p.applied_moment, owned, Kokkos::ALL), st_.moment);
+  }
+  void restore_applied() {
+    auto& p = disc_.points;
+    const auto owned = std::make_pair(std::size_t(0), p.n_owned);
+    Kokkos::deep_copy(st_.force, Kokkos::subview(p.applied_force, owned, Kokkos::ALL));
+    Kokkos::deep_copy(st_.moment, Kokkos::subview(p.applied_moment, owned, Kokkos::ALL));
   }
 
   // sum_i V_i S_r (p*_old + p*_new)/2 (tr eps_new - tr eps_old) of this step (this rank's
