@@ -690,6 +690,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   }
   ph.damage->update();
   disc.dist.refresh(pts.double_fields(kGhosted));
+  ph.damage->update_aperture();
   ph.initialize(time, restarted);
   const double dt = choose_time_step(run, ph, restarted, rank, out);
 

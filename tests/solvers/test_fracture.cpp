@@ -2,7 +2,8 @@
 // opened through a uniform grid releases G_cr per unit crack area (2D and 3D), the work done on
 // the body equals the energy released once the halves are apart (the solid energy balance with
 // fracture dissipation closes), both copies of every bond hold the same energy to the last bit
-// and break on the same step, on any number of ranks.
+// and break on the same step, on any number of ranks; the crack's aperture (eqs 38-39) is the
+// opening.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -62,6 +63,8 @@ struct Opening {
   double fracture_energy = 0, bond_energy = 0, external_work = 0, internal_energy = 0;
   long long crossing = 0, crossing_broken = 0, other_broken = 0;
   int first_break_step = -1, last_break_step = -1;
+  double aperture_min = 0, aperture_max = 0;  // of the points with broken bonds, middle part
+  double opening = 0;                         // the jump s at the end
   bool symmetric = true;  // both copies same W bits and same intact flag, at every check
 };
 
@@ -153,6 +156,10 @@ Opening open_crack(std::array<long long, Dim> counts, double factor, double s_ma
     broken = now;
   }
   check_symmetry();
+  Damage<Dim> damage(disc, 0.3, MPI_COMM_WORLD);
+  damage.update();
+  damage.update_aperture();
+  o.opening = s_max;
 
   // Crossing bonds, broken or not; released energy of the points whose x (and z) lie in the
   // middle of the body, where every column sees full families: per unit area of crack.
@@ -167,7 +174,9 @@ Opening open_crack(std::array<long long, Dim> counts, double factor, double s_ma
   const int margin = int(std::ceil(factor)) + 1;
   auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.x);
   auto rel = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.bond_energy_released);
-  double sum = 0, area = 1;
+  auto ap = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.aperture);
+  auto dmg = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.damage);
+  double sum = 0, area = 1, amin = 1e300, amax = -1e300;
   for (std::size_t i = 0; i < disc.points.n_owned; ++i) {
     bool mid = true;
     for (int d = 0; d < Dim; ++d)
@@ -175,8 +184,14 @@ Opening open_crack(std::array<long long, Dim> counts, double factor, double s_ma
         mid = mid && x(i, d) > margin * dx && x(i, d) < (double(counts[d]) - margin) * dx;
     if (mid)
       sum += rel(i);
+    if (mid && dmg(i) > 0) {
+      amin = std::min(amin, ap(i));
+      amax = std::max(amax, ap(i));
+    }
   }
   MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(&amin, &o.aperture_min, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&amax, &o.aperture_max, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   for (int d = 0; d < Dim; ++d)
     if (d != 1)
       area *= (double(counts[d]) - 2 * margin) * dx;
@@ -237,6 +252,10 @@ void expect_energy_release(const Opening& o, double factor) {
   EXPECT_NEAR(o.fracture_energy, o.external_work, 1e-9 * o.external_work);
   EXPECT_NEAR(o.bond_energy, o.external_work, 1e-9 * o.external_work);
   EXPECT_TRUE(o.symmetric);
+  // Aperture (eqs 38-39): the halves are apart by the jump s, every broken bond opened by s
+  // across the crack: a = s at every point with broken bonds (away from the side faces).
+  EXPECT_NEAR(o.aperture_min, o.opening, 1e-9 * o.opening);
+  EXPECT_NEAR(o.aperture_max, o.opening, 1e-9 * o.opening);
 }
 
 TEST(Fracture, StraightCrackReleasesGcr2D) {

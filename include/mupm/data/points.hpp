@@ -71,6 +71,7 @@ struct Points {
   // Fracture.
   Scalars damage;                // D_i (eq 37)
   Bytes fracture;                // 1: fracture point (D >= D_cr or next to a pre-crack)
+  Scalars aperture;  // crack aperture a_f [m] (eqs 38-39) of points with broken bonds
   Scalars bond_energy_released;  // energy released by the point's broken bonds [J], half of
                                  // W V_i V_j per bond (the other half is at the other end)
   // Constitutive state: effective stress, couple stress, equivalent plastic strain.
@@ -172,6 +173,7 @@ struct Points {
     f(p.undrained_modulus, FieldSpec{"undrained_modulus", 1, 0});
     f(p.damage,            FieldSpec{"damage", 1, kState | kGhosted});
     f(p.fracture,          FieldSpec{"fracture", 1, kState});
+    f(p.aperture,          FieldSpec{"aperture", 1, kState});
     f(p.bond_energy_released, FieldSpec{"bond_energy_released", 1, kState});
     f(p.stress,            FieldSpec{"stress", D * D, kState});
     f(p.couple_stress,     FieldSpec{"couple_stress", R * D, kState});

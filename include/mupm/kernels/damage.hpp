@@ -5,6 +5,8 @@
 #ifndef MUPM_DAMAGE_HPP
 #define MUPM_DAMAGE_HPP
 
+#include <cmath>
+
 #include "mupm/data/bonds.hpp"
 #include "mupm/data/points.hpp"
 
@@ -31,6 +33,55 @@ void compute_damage(const Bonds& bonds, const Points<Dim>& p, double critical_da
         const double d = all > 0 ? 1.0 - kept / all : 0.0;
         damage(i) = d;
         fracture(i) = (flags(i) & kFlagPreCrack) || d >= critical_damage ? 1 : 0;
+      });
+}
+
+// Crack aperture of the points with broken bonds (eqs 38-39; FORMULATION "Fracture").
+// Eq 38, c = y~ cos(beta) - x, is the opening of a broken bond across the crack: with beta the
+// angle between the deformed bond y = xi + U and the crack normal n, and x the reference bond's
+// normal component xi.n (the paper's Figure 3), c = (xi + U).n - xi.n = U.n, U = u_j - u_i. The
+// paper gives no n; a point's broken bonds all cross the crack, so their sum points across it:
+// n_i = sum_broken xi / |sum_broken xi| (for a point on a straight crack's face, exactly the
+// normal by symmetry). Eq 39 averages c over the broken bonds with omega = 1:
+// a_i = sum_broken c V_j / sum_broken V_j, and a negative mean (faces pressed together) is 0.
+// Points without broken bonds get 0. Needs u current on the ghosts.
+template <int Dim>
+void compute_aperture(const Bonds& bonds, const Points<Dim>& p) {
+  auto offsets = bonds.offsets;
+  auto neighbor = bonds.neighbor;
+  auto intact = bonds.intact;
+  auto x = p.x, u = p.u;
+  auto volume = p.volume;
+  auto damage = p.damage;
+  auto aperture = p.aperture;
+  Kokkos::parallel_for(
+      "mupm::Fracture::aperture", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        double a = 0;
+        if (damage(i) > 0) {
+          double n[Dim] = {}, len = 0;
+          for (BondIndex b = offsets(i); b < offsets(i + 1); ++b)
+            if (!intact(b))
+              for (int d = 0; d < Dim; ++d)
+                n[d] += x(neighbor(b), d) - x(i, d);
+          for (int d = 0; d < Dim; ++d)
+            len += n[d] * n[d];
+          if (len > 0) {
+            len = std::sqrt(len);
+            double sum = 0, vsum = 0;
+            for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
+              if (intact(b))
+                continue;
+              const int j = neighbor(b);
+              double c = 0;
+              for (int d = 0; d < Dim; ++d)
+                c += (u(j, d) - u(i, d)) * n[d] / len;  // eq 38
+              sum += c * volume(j);
+              vsum += volume(j);
+            }
+            a = sum / vsum > 0 ? sum / vsum : 0.0;  // eq 39
+          }
+        }
+        aperture(i) = a;
       });
 }
 

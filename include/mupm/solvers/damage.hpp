@@ -37,7 +37,10 @@ class Damage : public Module {
 
   const char* name() const override { return "damage"; }
 
+  // Damage and fracture points (after bonds broke).
   void update() { compute_damage(disc_.bonds, disc_.points, critical_damage_); }
+  // Crack aperture (eqs 38-39) of the current displacement; u current on the ghosts.
+  void update_aperture() { compute_aperture(disc_.bonds, disc_.points); }
 
   // Volume-weighted mean damage and the number of broken bonds (each bond is listed by both
   // its ends). Sums over ranks in a fixed order would be needed for bit-equal sums; these are

@@ -42,6 +42,10 @@ struct StepSequence {
         fluid->bonds_changed();
       damage_seen = mechanics->broken_pairs();
     }
+    // The crack opens with the displacement: the aperture of the points with broken bonds
+    // (pre-cracks included) every step (the solid left u current on the ghosts).
+    if (damage && mechanics)
+      damage->update_aperture();
     // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
     if (fluid && !fluid_first && (step + 1) % fluid_every == 0)
       advance_fluid(mechanics ? t + dt - interval : t, interval);
