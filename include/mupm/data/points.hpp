@@ -71,7 +71,7 @@ struct Points {
   // Fracture.
   Scalars damage;                // D_i (eq 37)
   Bytes fracture;                // 1: fracture point (D >= D_cr or next to a pre-crack)
-  Scalars aperture;  // crack aperture a_f [m] (eqs 38-39) of points with broken bonds
+  Scalars aperture;              // crack aperture a_f [m] (eqs 38-39) of points with broken bonds
   Scalars bond_energy_released;  // energy released by the point's broken bonds [J], half of
                                  // W V_i V_j per bond (the other half is at the other end)
   // Constitutive state: effective stress, couple stress, equivalent plastic strain.

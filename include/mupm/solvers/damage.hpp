@@ -82,71 +82,81 @@ class Damage : public Module {
   // The first pre-crack's length and tip now (header). Collective.
   Tip crack_tip() const {
     const Crack& c = disc_.grid.cracks.front();
-    double S[3] = {0, 0, 0}, T[3] = {0, 0, 0}, d[3] = {0, 0, 0}, len = 0;
+    Ahead ahead;
+    double S[3] = {0, 0, 0}, len = 0;
+    ahead.x = disc_.points.x;
+    ahead.frac = disc_.points.fracture;
+    ahead.flags = disc_.points.flags;
     for (int k = 0; k < Dim; ++k) {
       S[k] = c.a[k];
-      T[k] = Dim == 2 ? c.b[k] : c.a[k] + c.b[k];
-      d[k] = T[k] - S[k];
-      len += d[k] * d[k];
+      ahead.T[k] = Dim == 2 ? c.b[k] : c.a[k] + c.b[k];
+      ahead.d[k] = ahead.T[k] - S[k];
+      len += ahead.d[k] * ahead.d[k];
     }
     len = std::sqrt(len);
     for (int k = 0; k < Dim; ++k)
-      d[k] /= len;
-    const auto& p = disc_.points;
-    auto x = p.x;
-    auto gid = p.gid;
-    auto frac = p.fracture;
-    auto flags = p.flags;
-    // Largest s, then the lowest global id among the points that have it.
+      ahead.d[k] /= len;
+    const std::size_t n = disc_.points.n_owned;
+    auto gid = disc_.points.gid;
+    auto x = disc_.points.x;
+    // Largest s, then the lowest global id among the points that have it, then its position.
     double best = 0;
     Kokkos::parallel_reduce(
-        "mupm::Diagnostics::crack_extent", range(0, p.n_owned),
+        "mupm::Diagnostics::crack_extent", range(0, n),
         KOKKOS_LAMBDA(const std::size_t i, double& m) {
-          if (!frac(i) || (flags(i) & (kFlagPreCrack | kFlagBoundaryLayer)))
-            return;
-          double s = 0;
-          for (int k = 0; k < Dim; ++k)
-            s += (x(i, k) - T[k]) * d[k];
-          m = s > m ? s : m;
+          double s;
+          if (ahead(i, s))
+            m = s > m ? s : m;
         },
         Kokkos::Max<double>(best));
     MPI_Allreduce(MPI_IN_PLACE, &best, 1, MPI_DOUBLE, MPI_MAX, comm_);
-    long long who = -1;
-    if (best > 0) {
-      long long mine = std::numeric_limits<long long>::max();
-      Kokkos::parallel_reduce(
-          "mupm::Diagnostics::crack_tip", range(0, p.n_owned),
-          KOKKOS_LAMBDA(const std::size_t i, long long& m) {
-            if (!frac(i) || (flags(i) & (kFlagPreCrack | kFlagBoundaryLayer)))
-              return;
-            double s = 0;
-            for (int k = 0; k < Dim; ++k)
-              s += (x(i, k) - T[k]) * d[k];
-            if (s == best && (long long)gid(i) < m)
-              m = (long long)gid(i);
-          },
-          Kokkos::Min<long long>(mine));
-      MPI_Allreduce(&mine, &who, 1, MPI_LONG_LONG, MPI_MIN, comm_);
-    }
     Tip tip;
-    tip.length = inside_length(S, T) + std::max(best, 0.0);
-    double xt[3] = {T[0], T[1], T[2]};
-    if (who >= 0) {
-      const auto xh = Kokkos::create_mirror_view_and_copy(HostSpace(), p.x);
-      const auto gh = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
-      double mine[3] = {0, 0, 0};
-      for (std::size_t i = 0; i < p.n_owned; ++i)
-        if ((long long)gh(i) == who)
-          for (int k = 0; k < Dim; ++k)
-            mine[k] = xh(i, k);
-      MPI_Allreduce(mine, xt, 3, MPI_DOUBLE, MPI_SUM, comm_);
+    tip.length = inside_length(S, ahead.T) + std::max(best, 0.0);
+    for (int k = 0; k < Dim; ++k)
+      tip.x[k] = ahead.T[k];
+    if (!(best > 0))
+      return tip;
+    long long mine = std::numeric_limits<long long>::max(), who = -1;
+    Kokkos::parallel_reduce(
+        "mupm::Diagnostics::crack_tip", range(0, n),
+        KOKKOS_LAMBDA(const std::size_t i, long long& m) {
+          double s;
+          if (ahead(i, s) && s == best && (long long)gid(i) < m)
+            m = (long long)gid(i);
+        },
+        Kokkos::Min<long long>(mine));
+    MPI_Allreduce(&mine, &who, 1, MPI_LONG_LONG, MPI_MIN, comm_);
+    for (int k = 0; k < Dim; ++k) {
+      double xk = 0;
+      Kokkos::parallel_reduce(
+          "mupm::Diagnostics::crack_tip_position", range(0, n),
+          KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+            if ((long long)gid(i) == who)
+              acc += x(i, k);
+          },
+          xk);
+      MPI_Allreduce(&xk, &tip.x[k], 1, MPI_DOUBLE, MPI_SUM, comm_);
     }
-    for (int k = 0; k < 3; ++k)
-      tip.x[k] = xt[k];
     return tip;
   }
 
  private:
+  // s = (x_i - T).d of a fracture point of the real body away from the pre-crack (header).
+  struct Ahead {
+    Vectors x;
+    Bytes frac;
+    Flags flags;
+    double T[3] = {0, 0, 0}, d[3] = {0, 0, 0};
+    KOKKOS_INLINE_FUNCTION bool operator()(std::size_t i, double& s) const {
+      if (!frac(i) || (flags(i) & (kFlagPreCrack | kFlagBoundaryLayer)))
+        return false;
+      s = 0;
+      for (int k = 0; k < Dim; ++k)
+        s += (x(i, k) - T[k]) * d[k];
+      return true;
+    }
+  };
+
   // Length of the segment S -> T inside the real body (a box).
   double inside_length(const double* S, const double* T) const {
     const auto& g = disc_.grid;

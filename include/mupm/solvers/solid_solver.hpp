@@ -108,12 +108,11 @@ class SolidSolver : public Mechanics {
     g("dissipation", dissipation_);
     g("pore_pressure_work", pore_work_);
     g("initial_balance", balance0_);
-    if (breaks())
+    if (breaks()) {
       g("fracture_energy", fracture_energy_);
-    if (breaks())
       g("bond_energy_released", bond_energy_released_);
-    if (breaks())
       g("broken_pairs", broken_pairs_);
+    }
   }
   void series(SeriesRow& row) const override {
     const auto e = energy();
@@ -169,9 +168,11 @@ class SolidSolver : public Mechanics {
     auto& p = disc_.points;
     mark_fixed(bcs_, p);
     update_density();
-    // The effective force state's bond energy needs the pore-water part of P1 apart, where
-    // there is pore water pressure: a fluid (undrained modulus set), or a held initial pressure.
-    if (breaks() && set_.fracture.effective_state && st_.P1w.extent(0) == 0 && has_pressure())
+    // Pore water pressure, for the whole run: a fluid (undrained modulus set from the start), or
+    // a held initial pressure (without a fluid p never changes). The effective force state's
+    // bond energy then needs the pore-water part of P1 apart.
+    pressure_ = breaks() && has_pressure();
+    if (pressure_ && set_.fracture.effective_state && st_.P1w.extent(0) == 0)
       st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
     if (!restarted)
       apply_kinematic(bcs_, p, t, 0.0);
@@ -260,7 +261,7 @@ class SolidSolver : public Mechanics {
     disc_.update_shape();
     st_.work = BondWork::Record;
     forces(t);
-    if (has_pressure()) {
+    if (pressure_) {
       auto ref = p.vol_strain_ref, vs = p.vol_strain;
       auto old = vs_old_;
       Kokkos::parallel_for(
@@ -595,6 +596,7 @@ class SolidSolver : public Mechanics {
   double fracture_energy_ = 0;       // strain energy lost to bond breakage since t = 0 [J]
   double bond_energy_released_ = 0;  // W V_i V_j of the bonds broken since t = 0 [J]
   double broken_pairs_ = 0;          // bond pairs broken since t = 0 (a restart global)
+  bool pressure_ = false;            // breakage run with pore pressure (initialize)
 };
 
 }  // namespace mupm
