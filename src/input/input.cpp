@@ -115,6 +115,10 @@ void bc_template(ParameterList& c) {
         "without one are impervious), or Fluid Source: water injected at Value [m^3/s; in 2D "
         "m^3/s per metre of thickness] spread over the region's points by volume (a point "
         "source: a region holding one point; a line: a one-row region; negative: extraction). "
+        "Fracture (Fracture->Fracture Flow = true): Fracture Pressure [Pa] prescribed on the "
+        "region's fracture points, or Fracture Source: water injected into the region's "
+        "fracture points at Value [m^3/s; in 2D per metre of thickness] (e.g. at a crack's "
+        "mouth; an error if the region has no fracture point). "
         "Component is ignored by the fluid conditions.",
         boundary_condition_options().validator());
   c.set("Region", std::string("All"), "Region name (Discretization->Regions, 'Layer -y', All).");
@@ -284,6 +288,17 @@ RCP<ParameterList> valid_parameters() {
           "effective stress breaks the skeleton). Total: with the pore-water part "
           "-S_r p K^-1 xi, as eq 34 is printed. The same without a fluid.",
           bond_energy_state_options().validator());
+    f.set("Fracture Flow", false,
+          "true: water in the cracks (Solver->Physics = Hydro-Mechanical). The fracture "
+          "points carry a fracture pressure p_f that flows along the crack by the cubic law "
+          "a^3/(12 mu_w) (mu_w = Fluid->Viscosity), exchanges water with the pores (eq 19) and "
+          "pushes the crack's faces apart; solved implicitly every fluid step. Conditions: "
+          "Fracture Pressure, Fracture Source. Derivations in "
+          "include/mupm/kernels/fracture_flow.hpp.");
+    f.set("Minimum Aperture", 1e-6,
+          "a_min [m]: the aperture of the fracture flow's conductance and storage is at least "
+          "this (a closed crack still conducts and stores a little; the paper gives none).",
+          positive());
   }
   {
     ParameterList& b =
@@ -648,6 +663,9 @@ void check_dimension_arrays(ParameterList& input) {
       throw InputError("Error, " + path_of(c, "Type") + " = " + type +
                        " needs Solver->Physics = Pore Fluid or Hydro-Mechanical (it is " + physics +
                        ").");
+    if (bc.fracture_fluid() && !input.sublist("Fracture").get<bool>("Fracture Flow"))
+      throw InputError("Error, " + path_of(c, "Type") + " = " + type +
+                       " needs mupm->Fracture->Fracture Flow = true.");
   }
   if (fluid) {
     const ParameterList& f = input.sublist("Fluid");
@@ -682,6 +700,10 @@ void check_dimension_arrays(ParameterList& input) {
                        ": use Automatic or Bulk Matching.");
   }
   const ParameterList& fr = input.sublist("Fracture");
+  if (fr.get<bool>("Fracture Flow") && phys != Physics::HydroMechanical)
+    throw InputError("Error, " + path_of(fr, "Fracture Flow") +
+                     " = true needs Solver->Physics = Hydro-Mechanical (it is " + physics +
+                     "): the crack's water lives between the solid's crack faces.");
   if (bond_breaking_options()(fr.get<std::string>("Bond Breakage")) != BondBreaking::None) {
     if (!has_solid(phys))
       throw InputError("Error, " + path_of(fr, "Bond Breakage") + " = " +

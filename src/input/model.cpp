@@ -1,5 +1,7 @@
 #include "mupm/input/model.hpp"
 
+#include "mupm/kernels/fracture_flow.hpp"
+
 #include <Teuchos_Array.hpp>
 
 namespace mupm {
@@ -57,7 +59,9 @@ const Options<BoundaryCondition::Kind>& boundary_condition_options() {
                {"Body Force", BoundaryCondition::BodyForce},
                {"Body Couple", BoundaryCondition::BodyCouple},
                {"Pore Pressure", BoundaryCondition::PorePressure},
-               {"Fluid Source", BoundaryCondition::FluidSource}});
+               {"Fluid Source", BoundaryCondition::FluidSource},
+               {"Fracture Pressure", BoundaryCondition::FracturePressure},
+               {"Fracture Source", BoundaryCondition::FractureSource}});
   return o;
 }
 const Options<TimeFunction::Kind>& time_function_options() {
@@ -149,6 +153,10 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.fracture.effective_state =
       bond_energy_state_options()(fracture.get<std::string>("Bond Energy Force State")) ==
       BondEnergyState::Effective;
+  m.fracture.flow = fracture.get<bool>("Fracture Flow");
+  m.fracture.viscosity = fluid.get<double>("Viscosity");
+  m.fracture.min_aperture = fracture.get<double>("Minimum Aperture");
+  m.fracture.crossing_measure = crossing_measure<Dim>(m.grid.horizon, m.grid.thickness);
 
   m.boundary_conditions = boundary_conditions_from_input(input);
   m.initial_conditions = initial_conditions_from_input(input);

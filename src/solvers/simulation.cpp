@@ -235,6 +235,8 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   } else if (physics == Physics::KinematicsOnly) {
     ph.mechanics = std::make_unique<Kinematics<Dim>>(disc);
   }
+  if (ph.fluid && model.fracture.flow)
+    ph.fluid->enable_fracture_flow(model.fracture);
   ph.damage = std::make_unique<Damage<Dim>>(disc, model.fracture.critical_damage, mpi);
   ph.spacing = disc.grid.dx;
   ph.sequence.mechanics = ph.mechanics.get();

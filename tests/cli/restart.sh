@@ -64,9 +64,12 @@ with h5py.File(f"{name}-straight/checkpoint.h5") as a, h5py.File(f"{name}-second
 PY
 }
 check solid inputs/quickstart.xml 40 7
-check coupled inputs/consolidation.xml 60 13
+check coupled inputs/consolidation.xml 60 14
 check fracture tests/cli/fracture_small.xml 440 10
 # The same plate saturated, hydro-mechanical (soft water so that dt stays stable): breakage
 # with pore water (effective force state, strain-reference shift, fluid re-evaluation).
-check fracture-hm tests/cli/fracture_small.xml 440 14 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|' 
+check fracture-hm tests/cli/fracture_small.xml 440 15 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|' 
+# The same with water in the crack: p_f, injection at the notch's mouth, exchange, crack
+# pressure on the faces (the network solve is gathered and serial: bit for bit on any ranks).
+check fracture-flow tests/cli/fracture_small.xml 440 16 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|; s|<Parameter name="Bond Breakage"|<Parameter name="Fracture Flow" type="bool" value="true"/><Parameter name="Bond Breakage"|; s|<ParameterList name="Pre-Cracks">|<ParameterList name="Regions"><ParameterList name="mouth"><Parameter name="Min" type="Array(double)" value="{0, 0.045}"/><Parameter name="Max" type="Array(double)" value="{0.005, 0.055}"/></ParameterList></ParameterList><ParameterList name="Pre-Cracks">|; s|<ParameterList name="Boundary Conditions">|<ParameterList name="Boundary Conditions"><ParameterList name="mouth"><Parameter name="Type" type="string" value="Fracture Source"/><Parameter name="Region" type="string" value="mouth"/><Parameter name="Value" type="double" value="5e-5"/></ParameterList>|'
 echo "restart: passed"

@@ -54,20 +54,23 @@ struct Points {
   Vectors u, v, a;              // displacement, velocity, acceleration [n][Dim]
   Vectors theta, omega, alpha;  // micro-rotation and its rates [n][RotDim]
   // Fluid (eqs 141-146) and fracture fluid (eqs 119-120).
-  Scalars p, p_rate;    // pore water pressure and its rate
-  Scalars pf, pf_rate;  // fracture pressure and its rate
+  Scalars p, p_rate;      // pore water pressure and its rate
+  Scalars pf, pf_rate;    // fracture pressure and its rate (fracture network points)
+  Scalars pf_saturation;  // S_rf of the fracture space; > 0 exactly on the fracture network
+  Scalars pf_content;     // water that entered the point's fracture space, per unit volume
   Scalars porosity, saturation;
-  Scalars rel_perm;           // relative permeability k_r (eq 56)
-  Vectors darcy_flux;         // q [m/s] (eq 54) [n][Dim]
-  Scalars vol_strain;         // tr(eps) of the solid (eq 117)
-  Scalars vol_strain_ref;     // tr(eps) at the last fluid update
-  Scalars fluid_content;      // water volume per unit volume, phi S_r (1 + p/K_w) at t = 0 plus
-                              // the increments C dp + S_r d(tr eps) of every fluid step
-  Scalars solid_pressure;     // p* of the forces the solid last applied (undrained split)
-  Vectors applied_force;      // force density f of the forces the solid last applied [n][Dim]
-  Vectors applied_moment;     // moment density of the forces the solid last applied [n][RotDim]
-  Scalars undrained_modulus;  // S_r / C [Pa]: dp = -(S_r/C) d(tr eps) at fixed water content;
-                              // 0 where p is prescribed or without a fluid (undrained split)
+  Scalars rel_perm;             // relative permeability k_r (eq 56)
+  Vectors darcy_flux;           // q [m/s] (eq 54) [n][Dim]
+  Scalars vol_strain;           // tr(eps) of the solid (eq 117)
+  Scalars vol_strain_ref;       // tr(eps) at the last fluid update
+  Scalars fluid_content;        // water volume per unit volume, phi S_r (1 + p/K_w) at t = 0 plus
+                                // the increments C dp + S_r d(tr eps) of every fluid step
+  Scalars solid_pressure;       // p* of the forces the solid last applied (undrained split)
+  Vectors applied_force;        // force density f of the forces the solid last applied [n][Dim]
+  Vectors applied_moment;       // moment density of the forces the solid last applied [n][RotDim]
+  Vectors applied_crack_force;  // the crack water's force density last applied [n][Dim]
+  Scalars undrained_modulus;    // S_r / C [Pa]: dp = -(S_r/C) d(tr eps) at fixed water content;
+                                // 0 where p is prescribed or without a fluid (undrained split)
   // Fracture.
   Scalars damage;                // D_i (eq 37)
   Bytes fracture;                // 1: fracture point (D >= D_cr or next to a pre-crack)
@@ -160,6 +163,8 @@ struct Points {
     f(p.p_rate,            FieldSpec{"pore_pressure_rate", 1, kCheckpoint});
     f(p.pf,                FieldSpec{"fracture_pressure", 1, kState | kGhosted | kFinite, "Fracture Pressure"});
     f(p.pf_rate,           FieldSpec{"fracture_pressure_rate", 1, kCheckpoint});
+    f(p.pf_saturation,     FieldSpec{"fracture_saturation", 1, kState | kGhosted});
+    f(p.pf_content,        FieldSpec{"fracture_fluid_content", 1, kState});
     f(p.porosity,          FieldSpec{"porosity", 1, kState, "Porosity"});
     f(p.saturation,        FieldSpec{"saturation", 1, kState, "Saturation"});
     f(p.rel_perm,          FieldSpec{"relative_permeability", 1, kState});
@@ -170,6 +175,7 @@ struct Points {
     f(p.solid_pressure,    FieldSpec{"solid_pressure", 1, kCheckpoint});
     f(p.applied_force,     FieldSpec{"applied_force", D, kCheckpoint});
     f(p.applied_moment,    FieldSpec{"applied_moment", R, kCheckpoint});
+    f(p.applied_crack_force, FieldSpec{"applied_crack_force", D, kCheckpoint});
     f(p.undrained_modulus, FieldSpec{"undrained_modulus", 1, 0});
     f(p.damage,            FieldSpec{"damage", 1, kState | kGhosted});
     f(p.fracture,          FieldSpec{"fracture", 1, kState});

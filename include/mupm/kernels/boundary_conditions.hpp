@@ -70,8 +70,10 @@ struct BoundaryCondition {
     Traction,
     BodyForce,
     BodyCouple,
-    PorePressure,  // prescribed p [Pa] on the region's points (drained boundary)
-    FluidSource    // water injected [m^3/s; in 2D per metre of thickness], spread by volume
+    PorePressure,      // prescribed p [Pa] on the region's points (drained boundary)
+    FluidSource,       // water injected [m^3/s; in 2D per metre of thickness], spread by volume
+    FracturePressure,  // prescribed p_f [Pa] on the region's fracture points
+    FractureSource     // water injected into the fracture points of the region [m^3/s; 2D: /m]
   };
   Kind kind = Displacement;
   std::string name;
@@ -82,7 +84,8 @@ struct BoundaryCondition {
   bool kinematic() const {
     return kind == Displacement || kind == Velocity || kind == MicroRotation;
   }
-  bool fluid() const { return kind == PorePressure || kind == FluidSource; }
+  bool fluid() const { return kind == PorePressure || kind == FluidSource || fracture_fluid(); }
+  bool fracture_fluid() const { return kind == FracturePressure || kind == FractureSource; }
   // Bit of Points::fixed this condition prescribes.
   template <int Dim>
   std::uint32_t fixed_bit() const {

@@ -12,6 +12,29 @@
 
 namespace mupm {
 
+// Unit normal of point i's crack: the sum of its broken bonds' vectors (they all cross the
+// crack), normalized. False (n = 0) without broken bonds.
+template <int Dim, class Offsets, class Neighbors, class Intact, class X>
+KOKKOS_INLINE_FUNCTION bool crack_normal(const Offsets& offsets, const Neighbors& neighbor,
+                                         const Intact& intact, const X& x, std::size_t i,
+                                         double n[Dim]) {
+  double len = 0;
+  for (int d = 0; d < Dim; ++d)
+    n[d] = 0;
+  for (BondIndex b = offsets(i); b < offsets(i + 1); ++b)
+    if (!intact(b))
+      for (int d = 0; d < Dim; ++d)
+        n[d] += x(neighbor(b), d) - x(i, d);
+  for (int d = 0; d < Dim; ++d)
+    len += n[d] * n[d];
+  if (!(len > 0))
+    return false;
+  len = std::sqrt(len);
+  for (int d = 0; d < Dim; ++d)
+    n[d] /= len;
+  return true;
+}
+
 // D_i and the fracture flags on the owned points.
 template <int Dim>
 void compute_damage(const Bonds& bonds, const Points<Dim>& p, double critical_damage) {
@@ -57,29 +80,20 @@ void compute_aperture(const Bonds& bonds, const Points<Dim>& p) {
   Kokkos::parallel_for(
       "mupm::Fracture::aperture", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         double a = 0;
-        if (damage(i) > 0) {
-          double n[Dim] = {}, len = 0;
-          for (BondIndex b = offsets(i); b < offsets(i + 1); ++b)
-            if (!intact(b))
-              for (int d = 0; d < Dim; ++d)
-                n[d] += x(neighbor(b), d) - x(i, d);
-          for (int d = 0; d < Dim; ++d)
-            len += n[d] * n[d];
-          if (len > 0) {
-            len = std::sqrt(len);
-            double sum = 0, vsum = 0;
-            for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
-              if (intact(b))
-                continue;
-              const int j = neighbor(b);
-              double c = 0;
-              for (int d = 0; d < Dim; ++d)
-                c += (u(j, d) - u(i, d)) * n[d] / len;  // eq 38
-              sum += c * volume(j);
-              vsum += volume(j);
-            }
-            a = sum / vsum > 0 ? sum / vsum : 0.0;  // eq 39
+        double n[Dim];
+        if (damage(i) > 0 && crack_normal<Dim>(offsets, neighbor, intact, x, i, n)) {
+          double sum = 0, vsum = 0;
+          for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
+            if (intact(b))
+              continue;
+            const int j = neighbor(b);
+            double c = 0;
+            for (int d = 0; d < Dim; ++d)
+              c += (u(j, d) - u(i, d)) * n[d];  // eq 38
+            sum += c * volume(j);
+            vsum += volume(j);
           }
+          a = sum / vsum > 0 ? sum / vsum : 0.0;  // eq 39
         }
         aperture(i) = a;
       });

@@ -15,6 +15,10 @@
 // and sum_i V_i div_i = 0 (each bond's flow appears with both signs), so
 //   rho_w sum_i V_i m_i (t) - rho_w sum_i V_i m_i (0) = inflow through pressure conditions +
 //   injected water, to round-off. The test FluidSolver.MassConservation checks both.
+// With fracture flow (Fracture->Fracture Flow) the fracture network's step runs inside every
+// substep and takes the exchange X of eq 19 out of the bulk as a sink
+// (include/mupm/solvers/fracture_flow.hpp); the CSV's fluid_mass_error is bulk + fracture water
+// - initial water - everything that entered through the conditions, zero to round-off.
 //
 // Energy (eqs 147-149, in power form): multiplying the mass balance by p gives
 //   d/dt sum V psi(p) = -sum V S_r p dV_s/dt - sum V p div + sum V p s + sum p supply,
@@ -38,12 +42,14 @@
 #include <mpi.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "mupm/kernels/boundary_conditions.hpp"
 #include "mupm/kernels/fluid.hpp"
 #include "mupm/mesh/discretization.hpp"
+#include "mupm/solvers/fracture_flow.hpp"
 #include "mupm/solvers/module.hpp"
 #include "mupm/solvers/power_iteration.hpp"
 
@@ -66,8 +72,9 @@ class FluidSolver : public Module {
               MPI_Comm comm)
       : disc_(disc), prm_(prm), comm_(comm) {
     for (auto& bc : bcs)
-      if (bc.fluid())
+      if (bc.fluid() && !bc.fracture_fluid())
         bcs_.push_back(bc);
+    all_bcs_ = bcs;
     auto& p = disc_.points;
     st_.allocate(p.size(), p.n_owned);
     source_ = Scalars("mupm::fluid_source", p.n_owned);
@@ -77,6 +84,15 @@ class FluidSolver : public Module {
   }
 
   const FluidState<Dim>& state() const { return st_; }
+
+  // Fracture flow on the fracture network (include/mupm/solvers/fracture_flow.hpp), coupled to
+  // this bulk by the exchange of eq 19 in every substep; takes the Fracture conditions.
+  void enable_fracture_flow(const FractureParams& prm) {
+    fracture_ = std::make_unique<FractureFlow<Dim>>(disc_, prm_, prm, all_bcs_, comm_);
+    phat_ = Scalars("mupm::bulk_predictor", disc_.points.n_owned);
+    sink_ = Scalars("mupm::fracture_exchange", disc_.points.n_owned);
+  }
+  const FractureFlow<Dim>* fracture_flow() const { return fracture_.get(); }
   const FluidParams& params() const { return prm_; }
 
   struct Energy {
@@ -105,6 +121,10 @@ class FluidSolver : public Module {
     g("coupling_work", energy_.coupling_work);
     g("dissipation", energy_.dissipation);
     g("external_work", energy_.external_work);
+    g("fluid_mass_initial", mass0_);
+    if (fracture_)
+      for (std::size_t k = 0; k < fracture_->conditions().size(); ++k)
+        g("inflow_" + fracture_->conditions()[k].name, fracture_->inflows()[k]);
   }
   void series(SeriesRow& row) const override {
     const auto e = energy();
@@ -113,9 +133,24 @@ class FluidSolver : public Module {
     row("fluid_dissipation", e.dissipation);
     row("fluid_external_work", e.external_work);
     row("fluid_energy_error", e.balance());
-    row("fluid_mass", fluid_mass());
-    for (std::size_t k = 0; k < bcs_.size(); ++k)
+    const double bulk = fluid_mass();
+    double fracture = 0, supplied = 0;
+    row("fluid_mass", bulk);
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
       row("fluid_inflow_" + bcs_[k].name, inflow_[k]);
+      supplied += inflow_[k];
+    }
+    if (fracture_) {
+      fracture = fracture_->mass();
+      row("fracture_fluid_mass", fracture);
+      row("fracture_points", double(fracture_->network_size()));
+      for (std::size_t k = 0; k < fracture_->conditions().size(); ++k) {
+        row("fluid_inflow_" + fracture_->conditions()[k].name, fracture_->inflows()[k]);
+        supplied += fracture_->inflows()[k];
+      }
+    }
+    // Water conservation [kg]: bulk + fracture - initial - everything that entered.
+    row("fluid_mass_error", (bulk + fracture - mass0_) - supplied);
   }
   // Energy balance (eqs 147-149, include/mupm/solvers/fluid_solver.hpp header).
   std::vector<EnergyBalance> energy_balances() const override {
@@ -139,6 +174,7 @@ class FluidSolver : public Module {
   // A solid initialized afterwards computes tr(eps): then call reset_strain_reference().
   void initialize(double t, bool restarted) {
     auto& p = disc_.points;
+    bool init_content = false;
     auto regions = p.regions;
     auto fixed = p.fixed, vol = p.volume;
     for (std::size_t k = 0; k < bcs_.size(); ++k) {
@@ -163,6 +199,7 @@ class FluidSolver : public Module {
     if (!restarted) {
       set_pressure(t, p.p);
       energy_.stored0 = stored_energy();
+      init_content = true;
       fluid_constitutive(p, prm_, st_);
       auto pw = p.p, phi = p.porosity, sr = p.saturation, m = p.fluid_content;
       auto vs = p.vol_strain, ref = p.vol_strain_ref;
@@ -173,6 +210,8 @@ class FluidSolver : public Module {
             ref(i) = vs(i);
           });
     }
+    if (init_content)
+      mass0_ = fluid_mass();
     evaluate();
   }
 
@@ -350,6 +389,22 @@ class FluidSolver : public Module {
     const VanGenuchten vg = prm_.retention;
     const double inv_kw = 1.0 / prm_.bulk_modulus;
     const double inv_total = 1.0 / dt_total;
+    if (fracture_) {
+      // The bulk's explicit step without the exchange (p^ of fracture_flow.hpp), then the
+      // exchange the fracture step takes, as a sink in the update below.
+      auto phat = phat_, sink = sink_;
+      Kokkos::parallel_for(
+          "mupm::Fluid::predictor", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            const double dv = (vs(i) - ref(i)) * inv_total * dt;
+            const double rhs = -sr(i) * dv + dt * (src(i) - flow(i));
+            phat(i) =
+                (fixed(i) & kFixedPressure) ? target(i) : pw(i) + (C(i) > 0 ? rhs / C(i) : 0.0);
+          });
+      fracture_->step(t, dt, phat, C, sink);
+      Kokkos::parallel_for(
+          "mupm::Fluid::exchange", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i) { src(i) -= sink(i); });
+    }
     double w[3] = {0, 0, 0};  // coupling work, flow dissipation, external work (energy_ doc)
     Kokkos::parallel_reduce(
         "mupm::Fluid::update", range(0, p.n_owned),
@@ -422,8 +477,11 @@ class FluidSolver : public Module {
   Discretization<Dim>& disc_;
   FluidParams prm_;
   MPI_Comm comm_;
-  std::vector<BoundaryCondition> bcs_;
+  std::vector<BoundaryCondition> bcs_, all_bcs_;
   FluidState<Dim> st_;
+  std::unique_ptr<FractureFlow<Dim>> fracture_;
+  Scalars phat_, sink_;
+  double mass0_ = 0;  // water in the body at t = 0 [kg]
   Scalars source_, supply_;
   std::vector<double> inflow_, region_volume_;
   Energy energy_;

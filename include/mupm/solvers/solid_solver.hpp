@@ -18,6 +18,7 @@
 #include "mupm/kernels/boundary_conditions.hpp"
 #include "mupm/kernels/central_difference.hpp"
 #include "mupm/kernels/fracture.hpp"
+#include "mupm/kernels/fracture_flow.hpp"
 #include "mupm/kernels/solid.hpp"
 #include "mupm/mesh/discretization.hpp"
 #include "mupm/solvers/module.hpp"
@@ -83,6 +84,8 @@ class SolidSolver : public Mechanics {
     rho_ = Scalars("mupm::density", p.n_owned);
     inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
     body_ = Vectors("mupm::body_force", p.n_owned, Dim);
+    if (set_.fracture.flow)
+      crack_ = Vectors("mupm::crack_force", p.n_owned, Dim);
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", breaks() ? p.size() : p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
@@ -464,6 +467,12 @@ class SolidSolver : public Mechanics {
       disc_.dist.refresh({p.u, p.theta});
     solid_forces(disc_, prm_, law_, st_);
     body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
+    if (set_.fracture.flow) {  // the crack's water on its faces (kernels/fracture_flow.hpp)
+      Kokkos::deep_copy(crack_, 0.0);
+      crack_pressure_force(disc_.bonds, p, set_.fracture.crossing_measure, crack_);
+      add_to_body(crack_);
+    }
+    forces_time_ = t;
     auto eps = st_.eps;
     auto vs = p.vol_strain;
     Kokkos::parallel_for(
@@ -484,12 +493,28 @@ class SolidSolver : public Mechanics {
     Kokkos::deep_copy(Kokkos::subview(p.solid_pressure, owned), st_.pstar);
     Kokkos::deep_copy(Kokkos::subview(p.applied_force, owned, Kokkos::ALL), st_.force);
     Kokkos::deep_copy(Kokkos::subview(p.applied_moment, owned, Kokkos::ALL), st_.moment);
+    if (set_.fracture.flow)
+      Kokkos::deep_copy(Kokkos::subview(p.applied_crack_force, owned, Kokkos::ALL), crack_);
   }
   void restore_applied() {
     auto& p = disc_.points;
     const auto owned = std::make_pair(std::size_t(0), p.n_owned);
     Kokkos::deep_copy(st_.force, Kokkos::subview(p.applied_force, owned, Kokkos::ALL));
     Kokkos::deep_copy(st_.moment, Kokkos::subview(p.applied_moment, owned, Kokkos::ALL));
+    if (set_.fracture.flow) {  // the crack force applied last, with the p_f of then
+      body_force_density(bcs_, p, disc_.grid.dx, forces_time_, body_, couple_);
+      Kokkos::deep_copy(crack_, Kokkos::subview(p.applied_crack_force, owned, Kokkos::ALL));
+      add_to_body(crack_);
+    }
+  }
+  void add_to_body(const Vectors& f) {
+    auto b = body_;
+    Kokkos::parallel_for(
+        "mupm::Solid::add_body", range(0, disc_.points.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i) {
+          for (int d = 0; d < Dim; ++d)
+            b(i, d) += f(i, d);
+        });
   }
 
   // sum_i V_i S_r (p*_old + p*_new)/2 (tr eps_new - tr eps_old) of this step (this rank's
@@ -590,7 +615,9 @@ class SolidSolver : public Mechanics {
   SolidState<Dim> st_;
   Scalars rho_, inertia_;
   Vectors body_, couple_, du_;
-  Vectors f_old_, l_old_;  // forces of the old bond set at a breakage
+  Vectors crack_;           // the crack water's force density (Fracture Flow)
+  double forces_time_ = 0;  // t of the last forces()
+  Vectors f_old_, l_old_;   // forces of the old bond set at a breakage
   Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
   double fracture_energy_ = 0;       // strain energy lost to bond breakage since t = 0 [J]

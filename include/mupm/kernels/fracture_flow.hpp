@@ -1,0 +1,114 @@
+// Fracture flow: the crack's normal, its cubic-law conductances and storage, and the force of
+// the crack's water on its faces (paper eqs 17-19, 38-39, 58, 114, 118-120, 144, 146;
+// FORMULATION "Fracture"). Kernels and plain functions only: no MPI. The network solve that
+// uses them is include/mupm/solvers/fracture_flow.hpp.
+//
+// The fracture space of a point. A crack of opening a between two faces is seen by the fracture
+// points (D >= D_cr) around it: for a straight crack along a lattice plane with delta = 3 dx and
+// D_cr = 0.3, one row on each side (the next rows lose 20 % of their bonds). Each of them gets
+// the crack's full opening as its aperture (eqs 38-39, include/mupm/kernels/damage.hpp), so the
+// crack is represented n_i times across its thickness, n_i the number of fracture points on the
+// line through x_i along the crack normal: the fracture points j of i's family with
+// |xi_par| < dx/2 (xi_par the part of xi = x_j - x_i in the crack plane), plus i itself. Point i
+// then carries the share A_i = V_i / (n_i dx) of the crack's face area and the share
+// phi_f,i = a_i / (n_i dx) of the crack's volume per unit volume.
+//
+// Conductance (deviation from eqs 58, 120, 123-124; say why): the paper writes the fracture flow
+// with the correspondence gradient of the fracture family and k_f = a^2/12. The fracture family
+// of a crack one or two rows thick is nearly a line (a plane in 3D): its shape tensor is
+// singular across the crack, and k_f = a^2/12 smeared over a point of width dx passes dx/a times
+// the cubic law (FORMULATION). We use bond-based flow over the fracture bonds (both ends
+// fracture points, eq 104, broken or not), volume rate from j to i
+//   F_ij = Lambda_ij (p_f,j - p_f,i),   Lambda_ij = (kappa_i + kappa_j) / 2,
+// with kappa_i calibrated to the cubic law: a crack of aperture a passes a^3/(12 mu_w) dp/ds per
+// unit width. Under a uniform gradient g along the crack (tangent t), the rate across a
+// section is the sum over the pairs that straddle it of Lambda (xi.t) g; a pair of offset xi
+// straddles (xi.t)/dx of the sections per lattice column, so per unit width of crack
+//   Q = 1/2 sum_{i per unit face area} sum_j Lambda_ij (xi.t)^2 g = kappa m / (2 A_i) g
+// for a uniform band, m_i = sum_j |xi_par|^2 / (Dim - 1) (the in-plane mean of (xi.t)^2). Hence
+//   kappa_i = a_i^3 A_i / (6 mu_w m_i).
+// The test FractureFlow.CubicLawSlot checks the rate of a pressurized slot against a^3 dp/(12 mu
+// L). The calibration counts the crack's rows along the lattice: a crack inclined to the lattice
+// gets n_i and A_i approximately.
+//
+// Storage: the paper sets phi = 0 in the fracture space (eq 19) and eq 144 divides by
+// phi dS_rf/dp_f, zero when saturated. We give the water in the crack's volume its
+// compressibility: C_f,i = phi_f,i (dS_rf/dp_f + S_rf / K_w), phi_f,i with the aperture bounded
+// below by Fracture->Minimum Aperture (a closed crack keeps a storage and a conductance). As in
+// the paper there is no volume coupling in the fracture space (eq 19: "the volume coupling term
+// vanishes"): an opening crack does not draw water by its opening.
+//
+// Exchange (eq 19; eq 118 has the order flipped): from the bulk into the fracture, per unit
+// volume of the point, Q_s = (k_r k / mu_w) (p_w - p_f) / l_x * A / V with l_x = dx/2 and
+// A / V = 1/dx (a point's face on the crack): Q_s = G_i (p_w - p_f), G_i = 2 k_r k / (mu_w dx^2).
+//
+// Force of the crack's water on its faces (deviation from eq 17; say why). Eq 17 replaces
+// S_r T_w by S_rf T_f on the fracture bonds. Those bonds join fracture points on the same side
+// of the crack (the bonds across it are broken and carry no force), so they lie along the faces
+// and T_f = -p_f K^-1 xi pushes along the faces, not across: a pressurized crack would not
+// open. What the crack's water does is push on its faces with p_f. We apply that as a central
+// pair force on every broken bond i-j (each crosses the crack):
+//   f_i += -p_c V_j xi / m_c   (force density on i; the opposite on j),
+// m_c = sum over the pairs crossing a unit crack area of V_i V_j (xi.n): a bond xi crosses
+// it from the (xi.n) per unit area of points below, so m_c = int_{xi.n > 0} (xi.n)^2 dV =
+// 1/2 int_H xi_y^2 dV = pi h delta^4 / 8 in 2D (thickness h), 2 pi delta^5 / 15 in 3D. Summed over
+// the pairs crossing a straight crack this is p_c per unit face area along the normal, on
+// each face, pushing the faces apart; momentum and angular momentum are conserved (central
+// pairs). p_c is the crack pressure at the bond: the mean p_f of its ends that are in the
+// fracture network (one end, that one's; none, no force). The test FractureFlow.FacePressure
+// measures the total force on a face against p_f times its area.
+#ifndef MUPM_FRACTURE_FLOW_HPP
+#define MUPM_FRACTURE_FLOW_HPP
+
+#include <cmath>
+
+#include "mupm/kernels/damage.hpp"
+
+namespace mupm {
+
+// m_c of the crack-pressure force: the pairs crossing a unit crack area, weighted by xi.n
+// (header).
+template <int Dim>
+double crossing_measure(double horizon, double thickness) {
+  if constexpr (Dim == 3)
+    return 2.0 * M_PI * std::pow(horizon, 5) / 15.0;
+  else
+    return M_PI * thickness * std::pow(horizon, 4) / 8.0;
+}
+
+// Adds the crack's water pressure on its faces to the force density `body` of the owned points
+// (header): over every broken bond, -p_c V_j xi / m_c. A point is in the fracture network where
+// its fracture_saturation is > 0; p_f and fracture_saturation must be current on the ghosts.
+template <int Dim>
+void crack_pressure_force(const Bonds& bonds, const Points<Dim>& pts, double m_c,
+                          const Vectors& body) {
+  auto offsets = bonds.offsets;
+  auto neighbor = bonds.neighbor;
+  auto intact = bonds.intact;
+  auto x = pts.x, vol = pts.volume;
+  auto pf = pts.pf, sat = pts.pf_saturation;
+  const double inv_m = 1.0 / m_c;
+  Kokkos::parallel_for(
+      "mupm::Fracture::crack_pressure", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        double f[Dim] = {};
+        const bool in_i = sat(i) > 0;
+        for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
+          if (intact(b))
+            continue;
+          const int j = neighbor(b);
+          const bool in_j = sat(j) > 0;
+          if (!in_i && !in_j)
+            continue;
+          const double pc = in_i && in_j ? 0.5 * (pf(i) + pf(j)) : (in_i ? pf(i) : pf(j));
+          const double s = -pc * vol(j) * inv_m;
+          for (int d = 0; d < Dim; ++d)
+            f[d] += s * (x(j, d) - x(i, d));
+        }
+        for (int d = 0; d < Dim; ++d)
+          body(i, d) += f[d];
+      });
+}
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,413 @@
+// The fracture-flow step (paper eqs 18-19, 114, 118-120, 144, 146; FORMULATION "Fracture"):
+// the fracture pressure p_f on the fracture network, its water content, the exchange with the
+// bulk and the fracture conditions (Fracture Pressure, Fracture Source). Conductances, storage
+// and exchange are derived in include/mupm/kernels/fracture_flow.hpp.
+//
+// Why implicit (deviation from eqs 144, 146 with beta_3 = 0). The fracture's diffusivity is
+// a^2 K_w / (12 mu_w): 1.8e3 m^2/s for a = 0.1 mm, so a forward-Euler step on dx = 2.5 mm would
+// have to stay below ~1e-9 s, a thousandth of the solid's step. p_f is advanced by backward
+// Euler instead, with the exchange implicit on both sides:
+//   V_i C_f,i (p_i - p_i^n)/dt = sum_j Lambda_ij (p_j - p_i) + V_i G'_i (p^_i - p_i) + Q_i,
+// p^_i the bulk pressure the bulk's explicit step would reach without the exchange and
+// G'_i = G_i C_i / (C_i + dt G_i) (C_i the bulk storage): eliminating the bulk's p_w^{n+1} from
+// C_i (p_w^{n+1} - p_w^n) = (explicit terms) - dt G_i (p_w^{n+1} - p_i) gives exactly this,
+// and the exchange then never limits the bulk's stable step. On a bulk point of prescribed
+// pressure G' = G and p^ the prescribed value. The bulk takes X_i = dt V_i G'_i (p^_i - p_i) out
+// as a sink (include/mupm/solvers/fluid_solver.hpp), the fracture takes it in: fluid mass is
+// conserved to round-off. C_f and S_rf are those of p_f^n (linearized over the step).
+//
+// The network is small (the fracture points of a 2D body lie on lines, of a 3D body on
+// surfaces): every rank gathers it whole (its points' positions, apertures, normals, bulk
+// state and neighbour ids), assembles the same symmetric positive definite system in global-id
+// order and solves it by Jacobi-preconditioned conjugate gradients, serially. Every rank gets the
+// same bits whatever the number of ranks or threads, and the ghosts get their p_f without an
+// exchange. A solve that does not converge stops the run (CollectiveError), never a silent
+// garbage p_f.
+//
+// Water content: each fracture point's content grows by what flowed in over the step,
+//   dt (sum_j Lambda_ij (p_j - p_i) + Q_i) + X_i,
+// (on a point of prescribed p_f the reservoir supplies V C_f dp minus that, counted as the
+// condition's inflow). Summed over the network the bond flows cancel pair by pair, so
+// fracture water = injected + exchanged + supplied, to round-off. A point joins the network
+// (becomes a fracture point) with p_f = its bulk p_w and no content: the crack's new volume at
+// that pressure is not booked (no volume coupling in the fracture space, eq 19).
+#ifndef MUPM_SOLVERS_FRACTURE_FLOW_HPP
+#define MUPM_SOLVERS_FRACTURE_FLOW_HPP
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "mupm/core/error.hpp"
+#include "mupm/kernels/boundary_conditions.hpp"
+#include "mupm/kernels/fluid.hpp"
+#include "mupm/kernels/fracture.hpp"
+#include "mupm/kernels/fracture_flow.hpp"
+#include "mupm/mesh/discretization.hpp"
+#include "mupm/solvers/module.hpp"
+
+namespace mupm {
+
+template <int Dim>
+class FractureFlow {
+  static_assert(Kokkos::SpaceAccessibility<HostSpace, MemSpace>::accessible,
+                "the network is packed on the host");
+
+ public:
+  FractureFlow(Discretization<Dim>& disc, const FluidParams& fluid, const FractureParams& prm,
+               const std::vector<BoundaryCondition>& bcs, MPI_Comm comm)
+      : disc_(disc), fluid_(fluid), prm_(prm), comm_(comm) {
+    for (const auto& bc : bcs)
+      if (bc.kind == BoundaryCondition::FracturePressure ||
+          bc.kind == BoundaryCondition::FractureSource)
+        bcs_.push_back(bc);
+    inflow_.assign(bcs_.size(), 0.0);
+  }
+
+  // Names of the conditions, with the water [kg] that entered through each so far.
+  const std::vector<BoundaryCondition>& conditions() const { return bcs_; }
+  std::vector<double>& inflows() { return inflow_; }
+  const std::vector<double>& inflows() const { return inflow_; }
+  long long network_size() const { return last_size_; }
+  int last_iterations() const { return last_iterations_; }
+
+  // Water in the fracture spaces [kg]: rho_w sum_i V_i content_i.
+  double mass() const {
+    const auto& p = disc_.points;
+    auto m = p.pf_content, vol = p.volume;
+    double s = 0;
+    Kokkos::parallel_reduce(
+        "mupm::FractureFlow::mass", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += m(i) * vol(i); }, s);
+    MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return fluid_.water_density * s;
+  }
+
+  // One step t -> t + dt (header). phat: the bulk pressure of the explicit step without the
+  // exchange, C: the bulk storage (owned points). sink: the exchange per unit volume and time
+  // [1/s] the bulk loses, written for every owned point (0 off the network).
+  void step(double t, double dt, const Scalars& phat, const Scalars& C, const Scalars& sink) {
+    ScopedRegion region("mupm::FractureFlow::step");
+    gather(phat, C);
+    const int n = int(gid_.size());
+    last_size_ = n;
+    Kokkos::deep_copy(sink, 0.0);
+    if (n == 0)
+      return;
+    assemble(t, dt);
+    solve();
+    scatter(dt, sink);
+  }
+
+ private:
+  // Per gathered point: the doubles of a record (pack()), in this order.
+  enum Slot { kGid, kVol, kAp, kPhat, kC, kG, kBulkFixed, kPold, kRegions, kNnb, kX };
+  static constexpr int kRecord = kX + 2 * Dim;  // then x[Dim], n[Dim]
+
+  void gather(const Scalars& phat, const Scalars& C) {
+    auto& p = disc_.points;
+    const auto& b = disc_.bonds;
+    const double dx = disc_.grid.dx;
+    const double g0 = 2.0 * fluid_.mobility / (dx * dx);  // G / k_r (eq 19, kernels header)
+    std::vector<double> rec;
+    std::vector<long long> nb;
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      if (!p.fracture(i))
+        continue;
+      double nrm[Dim];
+      if (!crack_normal<Dim>(b.offsets, b.neighbor, b.intact, p.x, i, nrm))
+        for (int d = 0; d < Dim; ++d)
+          nrm[d] = 0;
+      const bool fresh = !(p.pf_saturation(i) > 0);
+      const BondIndex e0 = b.offsets(i), e1 = b.offsets(i + 1);
+      const double r[kX] = {double(p.gid(i)),
+                            p.volume(i),
+                            p.aperture(i),
+                            phat(i),
+                            C(i),
+                            g0 * p.rel_perm(i),
+                            (p.fixed(i) & kFixedPressure) ? 1.0 : 0.0,
+                            fresh ? p.p(i) : p.pf(i),
+                            double(p.regions(i)),
+                            double(e1 - e0)};
+      rec.insert(rec.end(), r, r + kX);
+      for (int d = 0; d < Dim; ++d)
+        rec.push_back(p.x(i, d));
+      for (int d = 0; d < Dim; ++d)
+        rec.push_back(nrm[d]);
+      for (BondIndex e = e0; e < e1; ++e)
+        nb.push_back(p.gid(b.neighbor(e)));
+    }
+    std::vector<double> all_rec = allgather(rec, MPI_DOUBLE);
+    std::vector<long long> all_nb = allgather(nb, MPI_LONG_LONG);
+    const int n = int(all_rec.size() / kRecord);
+    // Global-id order, whatever the ranks.
+    std::vector<long long> first(n + 1, 0);
+    for (int k = 0; k < n; ++k)
+      first[k + 1] = first[k] + (long long)all_rec[std::size_t(k) * kRecord + kNnb];
+    std::vector<int> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int a, int c) {
+      return all_rec[std::size_t(a) * kRecord] < all_rec[std::size_t(c) * kRecord];
+    });
+    rec_.resize(std::size_t(n) * kRecord);
+    gid_.resize(n);
+    nb_.clear();
+    nb_first_.assign(1, 0);
+    for (int k = 0; k < n; ++k) {
+      const int s = order[k];
+      std::copy(all_rec.begin() + std::size_t(s) * kRecord,
+                all_rec.begin() + std::size_t(s + 1) * kRecord,
+                rec_.begin() + std::size_t(k) * kRecord);
+      gid_[k] = (long long)rec_[std::size_t(k) * kRecord];
+      nb_.insert(nb_.end(), all_nb.begin() + first[s], all_nb.begin() + first[s + 1]);
+      nb_first_.push_back((long long)nb_.size());
+    }
+  }
+
+  template <class T>
+  std::vector<T> allgather(const std::vector<T>& mine, MPI_Datatype type) const {
+    int size = 0;
+    MPI_Comm_size(comm_, &size);
+    int count = int(mine.size());
+    std::vector<int> counts(size), displs(size, 0);
+    MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+    for (int r = 1; r < size; ++r)
+      displs[r] = displs[r - 1] + counts[r - 1];
+    std::vector<T> out(std::size_t(displs[size - 1] + counts[size - 1]));
+    MPI_Allgatherv(mine.data(), count, type, out.data(), counts.data(), displs.data(), type, comm_);
+    return out;
+  }
+
+  int index_of(long long gid) const {
+    auto it = std::lower_bound(gid_.begin(), gid_.end(), gid);
+    return it != gid_.end() && *it == gid ? int(it - gid_.begin()) : -1;
+  }
+  double r(int k, int slot) const { return rec_[std::size_t(k) * kRecord + slot]; }
+
+  // The system of the header, in global-id order: CSR adjacency, conductances, diagonal,
+  // right-hand side; prescribed p_f and the sources at t + dt / t.
+  void assemble(double t, double dt) {
+    const int n = int(gid_.size());
+    const double dx = disc_.grid.dx;
+    const double h = Dim == 2 ? disc_.grid.thickness : 1.0;
+    const double mu = prm_.viscosity, amin = prm_.min_aperture;
+    const double inv_kw = 1.0 / fluid_.bulk_modulus;
+    const VanGenuchten vg = fluid_.retention;
+    adj_first_.assign(1, 0);
+    adj_.clear();
+    std::vector<double> kappa(n, 0.0);
+    storage_.assign(n, 0.0);
+    gexch_.assign(n, 0.0);
+    for (int i = 0; i < n; ++i) {
+      std::vector<int> js;
+      for (long long e = nb_first_[i]; e < nb_first_[i + 1]; ++e) {
+        const int j = index_of(nb_[e]);
+        if (j >= 0 && j != i)
+          js.push_back(j);
+      }
+      std::sort(js.begin(), js.end());
+      js.erase(std::unique(js.begin(), js.end()), js.end());
+      double m = 0;
+      int rows = 1;
+      for (int j : js) {
+        double xi[Dim], xn = 0, par2 = 0;
+        for (int d = 0; d < Dim; ++d) {
+          xi[d] = r(j, kX + d) - r(i, kX + d);
+          xn += xi[d] * r(i, kX + Dim + d);
+        }
+        for (int d = 0; d < Dim; ++d) {
+          const double q = xi[d] - xn * r(i, kX + Dim + d);
+          par2 += q * q;
+        }
+        m += par2 / (Dim - 1);
+        rows += par2 < 0.25 * dx * dx ? 1 : 0;
+        adj_.push_back(j);
+      }
+      adj_first_.push_back((long long)adj_.size());
+      const double a = std::max(r(i, kAp), amin);
+      const double area = r(i, kVol) / (rows * dx);                // A_i
+      kappa[i] = m > 0 ? a * a * a * area / (6.0 * mu * m) : 0.0;  // kernels header
+      const double phi_f = a / (rows * dx);
+      const double pold = r(i, kPold);
+      storage_[i] = phi_f * (vg.dsaturation_dp(pold) + vg.saturation(pold) * inv_kw);
+      const double G = r(i, kG), Cb = r(i, kC);
+      gexch_[i] = r(i, kBulkFixed) != 0 ? G : (Cb > 0 ? G * Cb / (Cb + dt * G) : 0.0);
+    }
+    lambda_.resize(adj_.size());
+    diag_.assign(n, 0.0);
+    rhs_.assign(n, 0.0);
+    source_.assign(n, 0.0);
+    for (int i = 0; i < n; ++i) {
+      double s = 0;
+      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e) {
+        lambda_[e] = 0.5 * (kappa[i] + kappa[adj_[e]]);
+        s += lambda_[e];
+      }
+      const double v = r(i, kVol);
+      diag_[i] = v * storage_[i] / dt + v * gexch_[i] + s;
+      rhs_[i] = v * storage_[i] / dt * r(i, kPold) + v * gexch_[i] * r(i, kPhat);
+    }
+    // Conditions: sources [m^3/s] spread by volume over their network points at t; prescribed
+    // p_f at t + dt (later conditions win).
+    held_.assign(n, -1);
+    held_value_.assign(n, 0.0);
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      const auto& bc = bcs_[k];
+      const std::uint32_t mask = bc.region_mask;
+      auto in = [&](int i) { return mask == 0 || (std::uint32_t(r(i, kRegions)) & mask); };
+      if (bc.kind == BoundaryCondition::FractureSource) {
+        double vsum = 0;
+        for (int i = 0; i < n; ++i)
+          if (in(i))
+            vsum += r(i, kVol);
+        const double q = bc.value * bc.time(t) * h;
+        if (q != 0 && !(vsum > 0))
+          throw CollectiveError("Error, boundary condition '" + bc.name +
+                                "' (Fracture Source) has no fracture point in its region at t = " +
+                                std::to_string(t) + " s: put the region on the crack.");
+        for (int i = 0; i < n; ++i)
+          if (in(i))
+            source_[i] += q * r(i, kVol) / vsum;
+        inflow_[k] += fluid_.water_density * q * dt;
+      } else {
+        const double value = bc.value * bc.time(t + dt);
+        for (int i = 0; i < n; ++i)
+          if (in(i)) {
+            held_[i] = int(k);
+            held_value_[i] = value;
+          }
+      }
+    }
+    for (int i = 0; i < n; ++i)
+      rhs_[i] += source_[i];
+  }
+
+  // y = A x over the free rows (held entries of x taken as given).
+  void apply(const std::vector<double>& x, std::vector<double>& y) const {
+    const int n = int(gid_.size());
+    for (int i = 0; i < n; ++i) {
+      double s = diag_[i] * x[i];
+      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
+        s -= lambda_[e] * x[adj_[e]];
+      y[i] = s;
+    }
+  }
+
+  // Jacobi-preconditioned CG on the free rows, the held values moved to the right-hand side.
+  void solve() {
+    const int n = int(gid_.size());
+    x_.assign(n, 0.0);
+    std::vector<double> b(n), y(n), rr(n), z(n), d(n), q(n);
+    for (int i = 0; i < n; ++i)
+      if (held_[i] >= 0)
+        x_[i] = held_value_[i];
+    apply(x_, y);  // the held entries' contribution (x_ is zero on the free rows)
+    for (int i = 0; i < n; ++i)
+      b[i] = held_[i] >= 0 ? 0.0 : rhs_[i] - y[i];
+    auto dot = [&](const std::vector<double>& u, const std::vector<double>& v) {
+      double s = 0;
+      for (int i = 0; i < n; ++i)
+        if (held_[i] < 0)
+          s += u[i] * v[i];
+      return s;
+    };
+    const double bnorm = std::sqrt(dot(b, b));
+    std::vector<double> xf(n, 0.0);
+    for (int i = 0; i < n; ++i)  // start from p_f^n
+      xf[i] = held_[i] >= 0 ? 0.0 : r(i, kPold);
+    apply(xf, y);
+    for (int i = 0; i < n; ++i) {
+      rr[i] = held_[i] >= 0 ? 0.0 : b[i] - y[i];
+      z[i] = rr[i] / diag_[i];
+      d[i] = z[i];
+    }
+    double rz = dot(rr, z);
+    const double tol = 1e-13 * bnorm;
+    const int max_it = 10 * n + 100;
+    int it = 0;
+    while (std::sqrt(dot(rr, rr)) > tol && it < max_it) {
+      apply(d, q);
+      const double alpha = rz / dot(d, q);
+      for (int i = 0; i < n; ++i)
+        if (held_[i] < 0) {
+          xf[i] += alpha * d[i];
+          rr[i] -= alpha * q[i];
+          z[i] = rr[i] / diag_[i];
+        }
+      const double rz_new = dot(rr, z);
+      for (int i = 0; i < n; ++i)
+        if (held_[i] < 0)
+          d[i] = z[i] + (rz_new / rz) * d[i];
+      rz = rz_new;
+      ++it;
+    }
+    last_iterations_ = it;
+    if (std::sqrt(dot(rr, rr)) > tol && !(bnorm == 0))
+      throw CollectiveError("Error, the fracture-pressure solve did not converge in " +
+                            std::to_string(it) + " conjugate-gradient iterations (" +
+                            std::to_string(n) + " fracture points); residual " +
+                            std::to_string(std::sqrt(dot(rr, rr)) / bnorm) + " of the load.");
+    for (int i = 0; i < n; ++i)
+      if (held_[i] < 0)
+        x_[i] = xf[i];
+  }
+
+  // The new p_f, S_rf, rates and contents onto the local points, the exchange into `sink`,
+  // the reservoirs' supply into the conditions' inflows.
+  void scatter(double dt, const Scalars& sink) {
+    auto& p = disc_.points;
+    const int n = int(gid_.size());
+    const VanGenuchten vg = fluid_.retention;
+    std::vector<double> supplied(bcs_.size(), 0.0);
+    std::vector<double> gain(n), exch(n);
+    for (int i = 0; i < n; ++i) {
+      double flow = 0;
+      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
+        flow += lambda_[e] * (x_[adj_[e]] - x_[i]);
+      const double v = r(i, kVol);
+      exch[i] = dt * v * gexch_[i] * (r(i, kPhat) - x_[i]);
+      gain[i] = dt * (flow + source_[i]) + exch[i];
+      if (held_[i] >= 0) {
+        const double stored = v * storage_[i] * (x_[i] - r(i, kPold));
+        supplied[held_[i]] += stored - gain[i];
+        gain[i] = stored;
+      }
+    }
+    for (std::size_t k = 0; k < bcs_.size(); ++k)
+      inflow_[k] += fluid_.water_density * supplied[k];
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const int k = index_of(p.gid(i));
+      if (k < 0)
+        continue;
+      if (i < p.n_owned) {
+        p.pf_rate(i) = (x_[k] - r(k, kPold)) / dt;
+        p.pf_content(i) += gain[k] / r(k, kVol);
+        sink(i) = exch[k] / (dt * r(k, kVol));
+      }
+      p.pf(i) = x_[k];
+      p.pf_saturation(i) = vg.saturation(x_[k]);
+    }
+  }
+
+  Discretization<Dim>& disc_;
+  FluidParams fluid_;
+  FractureParams prm_;
+  MPI_Comm comm_;
+  std::vector<BoundaryCondition> bcs_;
+  std::vector<double> inflow_;
+  // The gathered network (global-id order) and its system.
+  std::vector<long long> gid_, nb_, nb_first_, adj_first_;
+  std::vector<double> rec_, lambda_, diag_, rhs_, source_, storage_, gexch_, x_, held_value_;
+  std::vector<int> adj_, held_;
+  long long last_size_ = 0;
+  int last_iterations_ = 0;
+};
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,285 @@
+// Fracture flow (include/mupm/kernels/fracture_flow.hpp, include/mupm/solvers/fracture_flow.hpp):
+// a slot of fixed aperture carries the cubic-law rate a^3 dp/(12 mu L) per unit width; a
+// fracture held at p_f drains the bulk at the rate of eq 19 (with the implicit exchange's
+// factor); the bulk, the fracture and the conditions' inflows conserve water to round-off; the
+// crack's water pushes each face with p_f per unit area.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "mupm/input/model.hpp"
+#include "mupm/kernels/fracture_flow.hpp"
+#include "mupm/solvers/damage.hpp"
+#include "mupm/solvers/fluid_solver.hpp"
+#include "test_utils.hpp"
+
+namespace mupm {
+namespace {
+
+constexpr double kDx = 2.5e-3;
+constexpr int kNx = 48, kNy = 8;
+
+// A 2D plate kNx x kNy cut through its whole width at y = H/2 (a pre-crack between rows 3 and
+// 4), delta = 3 dx; regions 0 "left" (x < 3 dx), 1 "right" (x > L - 3 dx), 2 "middle".
+struct Slot {
+  GridSpec<2> g;
+  Discretization<2> disc;
+  double L = kNx * kDx, H = kNy * kDx;
+  Slot() : g(make()), disc(discretize(test::world(), g)) {
+    Damage<2> damage(disc, 0.3, MPI_COMM_WORLD);
+    damage.update();
+  }
+  static GridSpec<2> make() {
+    auto g = test::box<2>({kNx, kNy}, 3.0, kDx);
+    const double L = kNx * kDx, H = kNy * kDx;
+    Crack c;
+    c.a[0] = -1;
+    c.a[1] = 0.5 * H;
+    c.b[0] = L + 1;
+    c.b[1] = 0.5 * H;
+    g.cracks = {c};
+    Box left, right, middle;
+    for (Box* b : {&left, &right, &middle}) {
+      b->lo[0] = b->lo[1] = -1;
+      b->hi[0] = b->hi[1] = 1;
+    }
+    left.hi[0] = 3 * kDx;
+    right.lo[0] = L - 3 * kDx;
+    middle.lo[0] = 0.25 * L;
+    middle.hi[0] = 0.75 * L;
+    g.region_names = {"left", "right", "middle"};
+    g.regions = {left, right, middle};
+    return g;
+  }
+  // Opens the crack by s: the upper half moves up by s/2, the lower half down (apertures = s).
+  void open(double s) {
+    auto x = disc.points.x, u = disc.points.u;
+    const double h = 0.5 * H;
+    Kokkos::parallel_for(
+        range(0, disc.points.size()),
+        KOKKOS_LAMBDA(const std::size_t i) { u(i, 1) = x(i, 1) > h ? 0.5 * s : -0.5 * s; });
+    compute_aperture(disc.bonds, disc.points);
+  }
+};
+
+BoundaryCondition condition(BoundaryCondition::Kind kind, const std::string& name, int region,
+                            double value) {
+  BoundaryCondition bc;
+  bc.kind = kind;
+  bc.name = name;
+  bc.region_mask = region < 0 ? 0u : 1u << region;
+  bc.value = value;
+  return bc;
+}
+
+FractureParams flow_params() {
+  FractureParams f;
+  f.flow = true;
+  f.viscosity = 1e-3;
+  f.min_aperture = 1e-7;
+  return f;
+}
+
+// Sum over the owned points of f(i), over all ranks.
+template <class F>
+double sum_owned(const Points<2>& p, F&& f) {
+  double s = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    s += f(i);
+  MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  return s;
+}
+
+// A slot of aperture a between an inlet held at p1 and an outlet at 0, impervious bulk: at
+// steady state the rate through it is a^3 h g / (12 mu), g the pressure gradient along it.
+TEST(FractureFlow, CubicLawSlot) {
+  Slot s;
+  const double a = 1e-4, p1 = 1e5, mu = 1e-3;
+  s.open(a);
+  auto prm = fluid_params(s.g, 0.0, 0.5);  // impervious bulk: no exchange
+  FluidSolver<2> fluid(s.disc, prm,
+                       {condition(BoundaryCondition::FracturePressure, "inlet", 0, p1),
+                        condition(BoundaryCondition::FracturePressure, "outlet", 1, 0.0)},
+                       MPI_COMM_WORLD);
+  fluid.enable_fracture_flow(flow_params());
+  fluid.initialize(0.0, false);
+  // Far beyond the slot's diffusion time L^2 (12 mu) / (a^2 K_w) ~ 7e-6 s: steady by then.
+  const double dt = 1e-3;
+  std::vector<double> in(2);
+  for (int n = 0; n < 6; ++n) {
+    const auto& q = fluid.fracture_flow()->inflows();
+    in = {q[0], q[1]};
+    fluid.advance(n * dt, dt, 1);
+  }
+  const auto& q = fluid.fracture_flow()->inflows();
+  const double rate_in = (q[0] - in[0]) / (prm.water_density * dt);    // m^3/s
+  const double rate_out = -(q[1] - in[1]) / (prm.water_density * dt);  // leaves at the outlet
+  // The gradient in the middle half, by least squares over its fracture points.
+  auto& p = s.disc.points;
+  const std::uint32_t mid = 1u << 2;
+  auto on = [&](std::size_t i) { return p.pf_saturation(i) > 0 && (p.regions(i) & mid); };
+  const double n = sum_owned(p, [&](std::size_t i) { return on(i) ? 1.0 : 0.0; });
+  const double sx = sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) : 0.0; });
+  const double sp = sum_owned(p, [&](std::size_t i) { return on(i) ? p.pf(i) : 0.0; });
+  const double sxx =
+      sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) * p.x(i, 0) : 0.0; });
+  const double sxp = sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) * p.pf(i) : 0.0; });
+  const double grad = (n * sxp - sx * sp) / (n * sxx - sx * sx);
+  const double cubic = a * a * a * s.g.thickness * (-grad) / (12 * mu);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0)
+    std::printf("slot: rate in %.6e, out %.6e, cubic law %.6e m^3/s (ratio %.5f), dp/dx %.4e\n",
+                rate_in, rate_out, cubic, rate_in / cubic, grad);
+  RecordProperty("rate_over_cubic_law", std::to_string(rate_in / cubic));
+  EXPECT_LT(grad, 0.0);
+  EXPECT_NEAR(rate_in, rate_out, 1e-9 * rate_in);  // steady: what enters leaves
+  EXPECT_NEAR(rate_in / cubic, 1.0, 0.05);
+  // The gradient is that of a linear drop over roughly the distance between the conditions.
+  EXPECT_NEAR(-grad * (s.L - 6 * kDx), p1, 0.2 * p1);
+}
+
+// A fracture held at p_f = 0 in a saturated bulk at p0 (no bulk flow: p is uniform): in one step
+// dt each fracture point's bulk loses dt G' p0 per unit volume, G = 2 k / (mu dx^2) (eq 19 with
+// l_x = dx/2, A/V = 1/dx), G' = G C / (C + dt G) (the implicit exchange); bulk + fracture +
+// reservoir water is conserved.
+TEST(FractureFlow, ExchangeDrainsTheBulkAtTheRateOfEq19) {
+  Slot s;
+  s.open(1e-4);
+  const double k_mu = 1e-12, p0 = 2e5, phi = 0.2;
+  auto prm = fluid_params(s.g, k_mu, 0.5);
+  auto& p = s.disc.points;
+  Kokkos::deep_copy(p.porosity, phi);
+  Kokkos::deep_copy(p.p, p0);
+  FluidSolver<2> fluid(s.disc, prm,
+                       {condition(BoundaryCondition::FracturePressure, "drain", -1, 0.0)},
+                       MPI_COMM_WORLD);
+  fluid.enable_fracture_flow(flow_params());
+  fluid.initialize(0.0, false);
+  const double C = phi / prm.bulk_modulus, G = 2 * k_mu / (kDx * kDx);
+  const double dt = 0.2 * C / G;  // dt G / C = 0.2: G' = G / 1.2
+  const double Gp = G * C / (C + dt * G);
+  std::vector<double> m0(p.n_owned);
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    m0[i] = p.fluid_content(i);
+  const double mass0 = fluid.fluid_mass();
+  fluid.advance(0.0, dt, 1);
+  double worst = 0, far = 0, n = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const double dm = p.fluid_content(i) - m0[i];
+    if (p.fracture(i)) {
+      worst = std::max(worst, std::abs(dm + dt * Gp * p0) / (dt * Gp * p0));
+      n += 1;
+    } else {
+      far = std::max(far, std::abs(dm));
+    }
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &far, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(n, 2.0 * kNx);  // one row each side of the crack
+  EXPECT_LT(worst, 1e-9);   // every fracture point's bulk lost dt G' p0
+  EXPECT_LT(far, 1e-9 * dt * Gp * p0);
+  // The bulk pressure of a fracture point fell to p0 C / (C + dt G).
+  double pw = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    if (p.fracture(i))
+      pw = std::max(pw, std::abs(p.p(i) - p0 * C / (C + dt * G)) / p0);
+  MPI_Allreduce(MPI_IN_PLACE, &pw, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  EXPECT_LT(pw, 1e-9);
+  // Water: the bulk lost what the fracture and its reservoir took.
+  const double lost = mass0 - fluid.fluid_mass();
+  const double taken = fluid.fracture_flow()->mass() - fluid.fracture_flow()->inflows()[0];
+  EXPECT_GT(lost, 0.0);
+  EXPECT_NEAR(taken, lost, 1e-12 * mass0);
+}
+
+// Injection into a closed slot in a permeable bulk, with the crack's aperture changing every
+// step: over many steps the water in the bulk plus the fracture equals the initial water plus
+// the injected, to round-off of the total; the pressure rose at the mouth first.
+TEST(FractureFlow, InjectionConservesWater) {
+  Slot s;
+  auto prm = fluid_params(s.g, 1e-13, 0.5);
+  auto& p = s.disc.points;
+  Kokkos::deep_copy(p.porosity, 0.2);
+  const double q = 5e-5;
+  FluidSolver<2> fluid(s.disc, prm, {condition(BoundaryCondition::FractureSource, "mouth", 0, q)},
+                       MPI_COMM_WORLD);
+  fluid.enable_fracture_flow(flow_params());
+  fluid.initialize(0.0, false);
+  const double mass0 = fluid.fluid_mass();
+  const double dt = 1e-5;
+  double worst = 0;
+  for (int n = 0; n < 40; ++n) {
+    s.open(1e-5 * (1 + 0.1 * n));  // the aperture grows: conductance and storage change
+    fluid.advance(n * dt, dt, 1);
+    const double total = fluid.fluid_mass() + fluid.fracture_flow()->mass();
+    const double in = fluid.fracture_flow()->inflows()[0];
+    worst = std::max(worst, std::abs(total - mass0 - in) / mass0);
+  }
+  const double injected = fluid.fracture_flow()->inflows()[0];
+  EXPECT_NEAR(injected, 1000 * q * 40 * dt, 1e-12 * injected);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0)
+    std::printf("injection: water error %.3e of the body's water, %.3e of the injected\n", worst,
+                worst * mass0 / injected);
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(fluid.fracture_flow()->mass(), 0.0);
+}
+
+// A uniform p_f on a straight crack pushes each face apart with p_f per unit area: the force on
+// the points above the crack, over the middle half of its length (full families), is
+// p_f * (L/2) * h along +y.
+TEST(FractureFlow, FacePressure) {
+  Slot s;
+  auto& p = s.disc.points;
+  const double pf = 3e5;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    p.pf(i) = p.fracture(i) ? pf : 0.0;
+    p.pf_saturation(i) = p.fracture(i) ? 1.0 : 0.0;
+  }
+  s.disc.dist.refresh({as_vectors(p.pf), as_vectors(p.pf_saturation)});
+  Vectors body("body", p.n_owned, 2);
+  crack_pressure_force(s.disc.bonds, p, crossing_measure<2>(s.g.horizon, s.g.thickness), body);
+  const std::uint32_t mid = 1u << 2;
+  double fy[2] = {0, 0}, fx = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    if (!(p.regions(i) & mid))
+      continue;
+    fy[p.x(i, 1) > 0.5 * s.H ? 0 : 1] += body(i, 1) * p.volume(i);
+    fx += body(i, 0) * p.volume(i);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, fy, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &fx, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  const double expected = pf * 0.5 * s.L * s.g.thickness;
+  // What the lattice gives: the crossing pairs per column, sum of xi.n over those with an
+  // end in the rows next to the crack (the others carry no p_c), against the continuum's
+  // pi delta^4 / 8 per unit length (rows k, m >= 1 below and above, horizontal offset c).
+  double lattice = 0;
+  for (int k = 1; k <= 4; ++k)
+    for (int m = 1; m <= 4; ++m)
+      for (int c = -4; c <= 4; ++c) {
+        const double dy = k + m - 1;
+        if ((k == 1 || m == 1) && within_horizon(dy * dy + c * c, 9.0))
+          lattice += dy;
+      }
+  lattice /= M_PI * 81.0 / 8.0;  // in units of dx: delta = 3
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0)
+    std::printf("face force: upper %.6e, lower %.6e, p_f A %.6e (ratio %.5f, lattice %.5f)\n",
+                fy[0], fy[1], expected, fy[0] / expected, lattice);
+  RecordProperty("face_force_over_pA", std::to_string(fy[0] / expected));
+  EXPECT_GT(fy[0], 0.0);                      // the upper face is pushed up
+  EXPECT_NEAR(fy[1], -fy[0], 1e-12 * fy[0]);  // and the lower one down, equally
+  EXPECT_NEAR(fx, 0.0, 1e-12 * fy[0]);        // no force along the crack
+  EXPECT_NEAR(fy[0] / expected, lattice, 1e-9);
+  // p_f per unit area within the lattice's error (about 2.5 % for delta = 3 dx).
+  EXPECT_NEAR(fy[0] / expected, 1.0, 0.03);
+}
+
+}  // namespace
+}  // namespace mupm
