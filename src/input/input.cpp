@@ -295,6 +295,14 @@ RCP<ParameterList> valid_parameters() {
           "pushes the crack's faces apart; solved implicitly every fluid step. Conditions: "
           "Fracture Pressure, Fracture Source. Derivations in "
           "include/mupm/kernels/fracture_flow.hpp.");
+    f.set("Crack Water Force", std::string("Face Pressure"),
+          "How the crack's water pressure p_f acts on the solid (Fracture Flow). Face "
+          "Pressure: p_f pushes the crack's faces apart (central pair forces on the broken "
+          "bonds, p_f per unit face area). Eq 17: as the paper prints it, bonds between two "
+          "fracture points carry -S_rf p_f K^-1 xi in place of -S_r p K^-1 xi; those bonds run "
+          "along the faces, so p_f barely acts across the crack. Derivations and why in "
+          "include/mupm/kernels/fracture_flow.hpp.",
+          crack_water_force_options().validator());
     f.set("Minimum Aperture", 1e-6,
           "a_min [m]: the aperture of the fracture flow's conductance and storage is at least "
           "this (a closed crack still conducts and stores a little; the paper gives none).",

@@ -44,6 +44,12 @@ const Options<BondBreaking>& bond_breaking_options() {
       "Bond Breakage", {{"None", BondBreaking::None}, {"Energy", BondBreaking::Energy}});
   return o;
 }
+const Options<CrackWaterForce>& crack_water_force_options() {
+  static const Options<CrackWaterForce> o(
+      "Crack Water Force",
+      {{"Face Pressure", CrackWaterForce::FacePressure}, {"Eq 17", CrackWaterForce::Eq17}});
+  return o;
+}
 const Options<BondEnergyState>& bond_energy_state_options() {
   static const Options<BondEnergyState> o(
       "Bond Energy Force State",
@@ -157,6 +163,9 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.fracture.viscosity = fluid.get<double>("Viscosity");
   m.fracture.min_aperture = fracture.get<double>("Minimum Aperture");
   m.fracture.crossing_measure = crossing_measure<Dim>(m.grid.horizon, m.grid.thickness);
+  m.fracture.face_pressure =
+      crack_water_force_options()(fracture.get<std::string>("Crack Water Force")) ==
+      CrackWaterForce::FacePressure;
 
   m.boundary_conditions = boundary_conditions_from_input(input);
   m.initial_conditions = initial_conditions_from_input(input);

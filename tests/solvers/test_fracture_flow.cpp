@@ -13,6 +13,7 @@
 #include "mupm/kernels/fracture_flow.hpp"
 #include "mupm/solvers/damage.hpp"
 #include "mupm/solvers/fluid_solver.hpp"
+#include "mupm/solvers/solid_solver.hpp"
 #include "test_utils.hpp"
 
 namespace mupm {
@@ -279,6 +280,41 @@ TEST(FractureFlow, FacePressure) {
   EXPECT_NEAR(fy[0] / expected, lattice, 1e-9);
   // p_f per unit area within the lattice's error (about 2.5 % for delta = 3 dx).
   EXPECT_NEAR(fy[0] / expected, 1.0, 0.03);
+}
+
+// Crack Water Force = Eq 17: a bond between two network points carries the water part of p_f
+// in place of p's. With every point in the network at p_f = p0 and p = 0, every bond is such a
+// bond: the forces must equal those of p = p0 without fracture flow (a wrong sign or factor of
+// the replacement would not).
+TEST(FractureFlow, Eq17ReplacesThePorePressureOnFractureBonds) {
+  Slot s;
+  auto& p = s.disc.points;
+  const double p0 = 4e5;
+  Kokkos::deep_copy(p.saturation, 1.0);
+  const auto law = MicropolarElastic::from_bulk_shear(270.83e6, 220.33e6, 100e6, 7.5e-3);
+  const auto prm = solid_params(law, s.g, 0.5);
+  auto forces = [&](bool eq17) {
+    SolidState<2> st;
+    st.allocate(p.size(), p.n_owned);
+    if (eq17)
+      st.P1f = Vectors("P1f", p.size(), 4);
+    Kokkos::deep_copy(p.p, eq17 ? 0.0 : p0);
+    Kokkos::deep_copy(p.pf, eq17 ? p0 : 0.0);
+    Kokkos::deep_copy(p.pf_saturation, eq17 ? 1.0 : 0.0);
+    solid_forces(s.disc, prm, st);
+    return st.force;
+  };
+  const auto ref = forces(false), f17 = forces(true);
+  double diff = 0, scale = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    for (int d = 0; d < 2; ++d) {
+      diff = std::max(diff, std::abs(f17(i, d) - ref(i, d)));
+      scale = std::max(scale, std::abs(ref(i, d)));
+    }
+  MPI_Allreduce(MPI_IN_PLACE, &diff, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &scale, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  EXPECT_GT(scale, 0.0);  // p0 pushes the free faces
+  EXPECT_LT(diff, 1e-9 * scale);
 }
 
 }  // namespace

@@ -32,6 +32,8 @@ enum class ConstitutiveModel { MicropolarElastic };
 enum class RetentionModel { Saturated, VanGenuchten };
 // Fracture->Bond Energy Force State.
 enum class BondEnergyState { Effective, Total };
+// Fracture->Crack Water Force.
+enum class CrackWaterForce { FacePressure, Eq17 };
 
 template <class E>
 class Options {
@@ -77,6 +79,7 @@ const Options<StabilizationModulus>& stabilization_modulus_options();
 const Options<RetentionModel>& retention_model_options();
 const Options<BondBreaking>& bond_breaking_options();
 const Options<BondEnergyState>& bond_energy_state_options();
+const Options<CrackWaterForce>& crack_water_force_options();
 const Options<BoundaryCondition::Kind>& boundary_condition_options();
 const Options<TimeFunction::Kind>& time_function_options();
 // Boundary Conditions->NAME->Component: the axis (x, y, z) as 0, 1, 2.

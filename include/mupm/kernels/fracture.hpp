@@ -42,6 +42,7 @@ struct FractureParams {
   double viscosity = 1e-3;      // mu_w [Pa s] of the cubic law
   double min_aperture = 1e-6;   // lower bound of the aperture in conductance and storage [m]
   double crossing_measure = 0;  // m_c of the crack-pressure force (crossing_measure<Dim>)
+  bool face_pressure = true;    // p_f on the crack's faces (true) or on fracture bonds (eq 17)
 };
 
 // W_cr of eq 36 (3D) and its plane-strain analogue (header), per pair of unit volumes.

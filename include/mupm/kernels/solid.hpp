@@ -80,6 +80,10 @@ struct SolidState {
   BondWork work = BondWork::Off;
   Vectors increment;
   Vectors P1w;
+  // Fracture flow with the paper's eq 17 (Fracture->Crack Water Force = Eq 17): on the fracture
+  // network (fracture_saturation > 0) (S_r p* - S_rf p_f) K^-1 [n_all][Dim*Dim], so that a
+  // bond between two network points carries -S_rf p_f K^-1 xi in place of -S_r p* K^-1 xi.
+  Vectors P1f;
   Scalars max_energy;  // largest W of the point's intact bonds after Accumulate [n_owned]
 
   void allocate(std::size_t n_all, std::size_t n_owned) {
@@ -99,6 +103,8 @@ struct SolidState {
     std::vector<Vectors> g{eps, kappa, P1, P2, as_vectors(w0)};
     if (P1w.extent(0) > 0)
       g.push_back(P1w);
+    if (P1f.extent(0) > 0)
+      g.push_back(P1f);
     return g;
   }
 };
@@ -148,6 +154,9 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
   auto pstar = st.pstar;
   auto P1w = st.P1w;
   const bool effective = P1w.extent(0) > 0;
+  auto P1f = st.P1f;
+  auto pf = pts.pf, srf = pts.pf_saturation;
+  const bool eq17 = P1f.extent(0) > 0;
   auto Kinv_v = shape.Kinv, fam = shape.family_volume;
   auto sing = shape.singular;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;  // G C1 |xi|^3
@@ -244,6 +253,11 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
         if (effective)
           for (int k = 0; k < Dim * Dim; ++k)
             P1w(i, k) = sr(i) * pe * Kinv[k];  // the pore-water part of P1, with opposite sign
+        if (eq17) {
+          const double dp = srf(i) > 0 ? sr(i) * pe - srf(i) * pf(i) : 0.0;  // eq 17
+          for (int k = 0; k < Dim * Dim; ++k)
+            P1f(i, k) = dp * Kinv[k];
+        }
         w0_v(i) = w0;
         pstar(i) = pe;
         degen(i) = singular ? 1 : 0;
@@ -284,6 +298,8 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   auto vol = pts.volume;
   auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, w0 = st.w0;
   auto inc = st.increment, P1w = st.P1w, wmax = st.max_energy;
+  auto P1f = st.P1f, srf = pts.pf_saturation;
+  const bool eq17 = P1f.extent(0) > 0;
   auto force = st.force, moment = st.moment;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
   const double c2 = prm.stabilization * prm.stab_modulus;
@@ -306,7 +322,16 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           const double a1j = w0(j) > 0 ? a1 / w0(j) : 0.0, a2j = w0(j) > 0 ? a2 / w0(j) : 0.0;
           // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
           //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
-          double t[Dim], m[R];
+          double t[Dim], m[R], cf[Dim] = {};
+          if (eq17 && srf(i) > 0 && srf(j) > 0)  // eq 17: the fracture bond's water is p_f's
+            for (int a = 0; a < Dim; ++a) {
+              double ci = 0, cj = 0;
+              for (int k = 0; k < Dim; ++k) {
+                ci += P1f(i, a * Dim + k) * xi[k];
+                cj += P1f(j, a * Dim + k) * xi[k];
+              }
+              cf[a] = ci + cj;
+            }
           for (int a = 0; a < Dim; ++a) {
             double pi = 0, pj = 0, ei = 0, ej = 0;
             for (int k = 0; k < Dim; ++k) {
@@ -315,7 +340,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
               ei += eps(i, a * Dim + k) * xi[k];
               ej += eps(j, a * Dim + k) * xi[k];
             }
-            t[a] = (pi + pj) + (a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej));
+            t[a] = ((pi + pj) + (a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej))) + cf[a];
             f[a] += t[a] * vj;
           }
           // M_ij - M_ji, Omega_ji = -Omega_ij.
@@ -342,7 +367,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
                   wi += P1w(i, a * Dim + k) * xi[k];
                   wj += P1w(j, a * Dim + k) * xi[k];
                 }
-                t[a] += wi + wj;
+                t[a] += (wi + wj) - cf[a];  // the bond's water part, whichever pressure
               }
             if (accumulate) {
               // dU^ = d(u_j - u_i) - (d theta_i + d theta_j)/2 x xi, dOmega = d theta_j - d

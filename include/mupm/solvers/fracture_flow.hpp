@@ -18,11 +18,11 @@
 //
 // The network is small (the fracture points of a 2D body lie on lines, of a 3D body on
 // surfaces): every rank gathers it whole (its points' positions, apertures, normals, bulk
-// state and neighbour ids), assembles the same symmetric positive definite system in global-id
-// order and solves it by Jacobi-preconditioned conjugate gradients, serially. Every rank gets the
-// same bits whatever the number of ranks or threads, and the ghosts get their p_f without an
-// exchange. A solve that does not converge stops the run (CollectiveError), never a silent
-// garbage p_f.
+// state and neighbour ids), assembles the same symmetric, diagonally dominant system in
+// global-id order and solves it directly (banded LU in reverse Cuthill-McKee order), serially.
+// Every rank gets the same bits whatever the number of ranks or threads, and the ghosts get
+// their p_f without an exchange. A singular system stops the run (CollectiveError), never a
+// silent garbage p_f.
 //
 // Water content: each fracture point's content grows by what flowed in over the step,
 //   dt (sum_j Lambda_ij (p_j - p_i) + Q_i) + X_i,
@@ -41,6 +41,8 @@
 #include <numeric>
 #include <string>
 #include <vector>
+
+#include <Teuchos_LAPACK.hpp>
 
 #include "mupm/core/error.hpp"
 #include "mupm/kernels/boundary_conditions.hpp"
@@ -73,7 +75,7 @@ class FractureFlow {
   std::vector<double>& inflows() { return inflow_; }
   const std::vector<double>& inflows() const { return inflow_; }
   long long network_size() const { return last_size_; }
-  int last_iterations() const { return last_iterations_; }
+  int last_bandwidth() const { return last_bandwidth_; }
 
   // Water in the fracture spaces [kg]: rho_w sum_i V_i content_i.
   double mass() const {
@@ -287,74 +289,93 @@ class FractureFlow {
       rhs_[i] += source_[i];
   }
 
-  // y = A x over the free rows (held entries of x taken as given).
-  void apply(const std::vector<double>& x, std::vector<double>& y) const {
-    const int n = int(gid_.size());
-    for (int i = 0; i < n; ++i) {
-      double s = diag_[i] * x[i];
-      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
-        s -= lambda_[e] * x[adj_[e]];
-      y[i] = s;
-    }
-  }
-
-  // Jacobi-preconditioned CG on the free rows, the held values moved to the right-hand side.
+  // The free rows' system, the held values moved to the right-hand side, by a banded LU
+  // (LAPACK GBTRF/GBTRS through Teuchos) in reverse Cuthill-McKee order: the network is a band
+  // of points along the crack, so its bandwidth stays of the order of the points within a
+  // horizon. Direct, as the conductances along an open crack exceed the storage by many orders
+  // (an iterative solver would need a condition-number-dependent number of iterations).
   void solve() {
     const int n = int(gid_.size());
     x_.assign(n, 0.0);
-    std::vector<double> b(n), y(n), rr(n), z(n), d(n), q(n);
+    std::vector<int> pos(n, -1), order;  // position of a free row in the band order
     for (int i = 0; i < n; ++i)
       if (held_[i] >= 0)
         x_[i] = held_value_[i];
-    apply(x_, y);  // the held entries' contribution (x_ is zero on the free rows)
+    // Reverse Cuthill-McKee over the free rows, component by component, from a free row of
+    // least degree (lowest global id among equals): the same order on every rank.
+    std::vector<int> degree(n, 0);
     for (int i = 0; i < n; ++i)
-      b[i] = held_[i] >= 0 ? 0.0 : rhs_[i] - y[i];
-    auto dot = [&](const std::vector<double>& u, const std::vector<double>& v) {
-      double s = 0;
+      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
+        degree[i] += held_[adj_[e]] < 0 ? 1 : 0;
+    std::vector<char> seen(n, 0);
+    for (;;) {
+      int start = -1;
       for (int i = 0; i < n; ++i)
-        if (held_[i] < 0)
-          s += u[i] * v[i];
-      return s;
-    };
-    const double bnorm = std::sqrt(dot(b, b));
-    std::vector<double> xf(n, 0.0);
-    for (int i = 0; i < n; ++i)  // start from p_f^n
-      xf[i] = held_[i] >= 0 ? 0.0 : r(i, kPold);
-    apply(xf, y);
-    for (int i = 0; i < n; ++i) {
-      rr[i] = held_[i] >= 0 ? 0.0 : b[i] - y[i];
-      z[i] = rr[i] / diag_[i];
-      d[i] = z[i];
-    }
-    double rz = dot(rr, z);
-    const double tol = 1e-13 * bnorm;
-    const int max_it = 10 * n + 100;
-    int it = 0;
-    while (std::sqrt(dot(rr, rr)) > tol && it < max_it) {
-      apply(d, q);
-      const double alpha = rz / dot(d, q);
-      for (int i = 0; i < n; ++i)
-        if (held_[i] < 0) {
-          xf[i] += alpha * d[i];
-          rr[i] -= alpha * q[i];
-          z[i] = rr[i] / diag_[i];
+        if (held_[i] < 0 && !seen[i] && (start < 0 || degree[i] < degree[start]))
+          start = i;
+      if (start < 0)
+        break;
+      std::size_t head = order.size();
+      order.push_back(start);
+      seen[start] = 1;
+      while (head < order.size()) {
+        const int i = order[head++];
+        std::vector<int> next;
+        for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e) {
+          const int j = adj_[e];
+          if (held_[j] < 0 && !seen[j]) {
+            seen[j] = 1;
+            next.push_back(j);
+          }
         }
-      const double rz_new = dot(rr, z);
-      for (int i = 0; i < n; ++i)
-        if (held_[i] < 0)
-          d[i] = z[i] + (rz_new / rz) * d[i];
-      rz = rz_new;
-      ++it;
+        std::stable_sort(next.begin(), next.end(),
+                         [&](int a, int b) { return degree[a] < degree[b]; });
+        order.insert(order.end(), next.begin(), next.end());
+      }
     }
-    last_iterations_ = it;
-    if (std::sqrt(dot(rr, rr)) > tol && !(bnorm == 0))
-      throw CollectiveError("Error, the fracture-pressure solve did not converge in " +
-                            std::to_string(it) + " conjugate-gradient iterations (" +
-                            std::to_string(n) + " fracture points); residual " +
-                            std::to_string(std::sqrt(dot(rr, rr)) / bnorm) + " of the load.");
+    std::reverse(order.begin(), order.end());
+    const int m = int(order.size());
+    if (m == 0)
+      return;
+    for (int k = 0; k < m; ++k)
+      pos[order[k]] = k;
+    int kd = 0;
     for (int i = 0; i < n; ++i)
-      if (held_[i] < 0)
-        x_[i] = xf[i];
+      if (pos[i] >= 0)
+        for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
+          if (pos[adj_[e]] >= 0)
+            kd = std::max(kd, std::abs(pos[i] - pos[adj_[e]]));
+    const int ldab = 3 * kd + 1;  // GBTRF's band storage: kl = ku = kd, plus kd for the fill
+    std::vector<double> ab(std::size_t(ldab) * m, 0.0), b(m);
+    auto at = [&](int r, int c) -> double& { return ab[std::size_t(c) * ldab + 2 * kd + r - c]; };
+    for (int i = 0; i < n; ++i) {
+      if (pos[i] < 0)
+        continue;
+      double rhs = rhs_[i];
+      at(pos[i], pos[i]) += diag_[i];
+      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e) {
+        const int j = adj_[e];
+        if (pos[j] >= 0)
+          at(pos[i], pos[j]) -= lambda_[e];
+        else
+          rhs += lambda_[e] * x_[j];  // a held neighbour
+      }
+      b[pos[i]] = rhs;
+    }
+    Teuchos::LAPACK<int, double> lapack;
+    std::vector<int> ipiv(m);
+    int info = 0;
+    lapack.GBTRF(m, m, kd, kd, ab.data(), ldab, ipiv.data(), &info);
+    if (info == 0)
+      lapack.GBTRS('N', m, kd, kd, 1, ab.data(), ldab, ipiv.data(), b.data(), m, &info);
+    if (info != 0)
+      throw CollectiveError("Error, the fracture-pressure system of " + std::to_string(m) +
+                            " fracture points is singular (LAPACK GBTRF/GBTRS info " +
+                            std::to_string(info) + ").");
+    for (int i = 0; i < n; ++i)
+      if (pos[i] >= 0)
+        x_[i] = b[pos[i]];
+    last_bandwidth_ = kd;
   }
 
   // The new p_f, S_rf, rates and contents onto the local points, the exchange into `sink`,
@@ -405,7 +426,7 @@ class FractureFlow {
   std::vector<double> rec_, lambda_, diag_, rhs_, source_, storage_, gexch_, x_, held_value_;
   std::vector<int> adj_, held_;
   long long last_size_ = 0;
-  int last_iterations_ = 0;
+  int last_bandwidth_ = 0;
 };
 
 }  // namespace mupm

@@ -84,8 +84,10 @@ class SolidSolver : public Mechanics {
     rho_ = Scalars("mupm::density", p.n_owned);
     inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
     body_ = Vectors("mupm::body_force", p.n_owned, Dim);
-    if (set_.fracture.flow)
+    if (face_pressure())
       crack_ = Vectors("mupm::crack_force", p.n_owned, Dim);
+    if (set_.fracture.flow && !set_.fracture.face_pressure)  // eq 17 (kernels/solid.hpp)
+      st_.P1f = Vectors("mupm::fracture_part_of_P1", p.size(), Dim * Dim);
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", breaks() ? p.size() : p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
@@ -467,7 +469,7 @@ class SolidSolver : public Mechanics {
       disc_.dist.refresh({p.u, p.theta});
     solid_forces(disc_, prm_, law_, st_);
     body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
-    if (set_.fracture.flow) {  // the crack's water on its faces (kernels/fracture_flow.hpp)
+    if (face_pressure()) {  // the crack's water on its faces (kernels/fracture_flow.hpp)
       Kokkos::deep_copy(crack_, 0.0);
       crack_pressure_force(disc_.bonds, p, set_.fracture.crossing_measure, crack_);
       add_to_body(crack_);
@@ -493,7 +495,7 @@ class SolidSolver : public Mechanics {
     Kokkos::deep_copy(Kokkos::subview(p.solid_pressure, owned), st_.pstar);
     Kokkos::deep_copy(Kokkos::subview(p.applied_force, owned, Kokkos::ALL), st_.force);
     Kokkos::deep_copy(Kokkos::subview(p.applied_moment, owned, Kokkos::ALL), st_.moment);
-    if (set_.fracture.flow)
+    if (face_pressure())
       Kokkos::deep_copy(Kokkos::subview(p.applied_crack_force, owned, Kokkos::ALL), crack_);
   }
   void restore_applied() {
@@ -501,12 +503,13 @@ class SolidSolver : public Mechanics {
     const auto owned = std::make_pair(std::size_t(0), p.n_owned);
     Kokkos::deep_copy(st_.force, Kokkos::subview(p.applied_force, owned, Kokkos::ALL));
     Kokkos::deep_copy(st_.moment, Kokkos::subview(p.applied_moment, owned, Kokkos::ALL));
-    if (set_.fracture.flow) {  // the crack force applied last, with the p_f of then
+    if (face_pressure()) {  // the crack force applied last, with the p_f of then
       body_force_density(bcs_, p, disc_.grid.dx, forces_time_, body_, couple_);
       Kokkos::deep_copy(crack_, Kokkos::subview(p.applied_crack_force, owned, Kokkos::ALL));
       add_to_body(crack_);
     }
   }
+  bool face_pressure() const { return set_.fracture.flow && set_.fracture.face_pressure; }
   void add_to_body(const Vectors& f) {
     auto b = body_;
     Kokkos::parallel_for(
