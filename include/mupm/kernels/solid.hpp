@@ -84,7 +84,8 @@ struct SolidState {
   // network (fracture_saturation > 0) (S_r p* - S_rf p_f) K^-1 [n_all][Dim*Dim], so that a
   // bond between two network points carries -S_rf p_f K^-1 xi in place of -S_r p* K^-1 xi.
   Vectors P1f;
-  Scalars max_energy;  // largest W of the point's intact bonds after Accumulate [n_owned]
+  Vectors water_force;  // the eq 17 part of (f, l) [n_owned][Dim + R] (with P1f)
+  Scalars max_energy;   // largest W of the point's intact bonds after Accumulate [n_owned]
 
   void allocate(std::size_t n_all, std::size_t n_owned) {
     eps = Vectors("mupm::eps", n_all, Dim * Dim);
@@ -299,6 +300,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, w0 = st.w0;
   auto inc = st.increment, P1w = st.P1w, wmax = st.max_energy;
   auto P1f = st.P1f, srf = pts.pf_saturation;
+  auto fw = st.water_force;
   const bool eq17 = P1f.extent(0) > 0;
   auto force = st.force, moment = st.moment;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
@@ -308,7 +310,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   const bool effective = P1w.extent(0) > 0;
   Kokkos::parallel_for(
       "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-        double f[Dim] = {}, l[R] = {}, wm = 0;
+        double f[Dim] = {}, l[R] = {}, wm = 0, f17[Dim + R] = {};
         for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
           if (!intact(b))
             continue;
@@ -332,6 +334,14 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
               }
               cf[a] = ci + cj;
             }
+          if (eq17) {
+            double xc[R];
+            cross<Dim>(xi, cf, xc);
+            for (int a = 0; a < Dim; ++a)
+              f17[a] += cf[a] * vj;
+            for (int r = 0; r < R; ++r)
+              f17[Dim + r] += 0.5 * xc[r] * vj;
+          }
           for (int a = 0; a < Dim; ++a) {
             double pi = 0, pj = 0, ei = 0, ej = 0;
             for (int k = 0; k < Dim; ++k) {
@@ -395,6 +405,9 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           moment(i, r) = l[r];
         if (accumulate)
           wmax(i) = wm;
+        if (eq17)
+          for (int c = 0; c < Dim + R; ++c)
+            fw(i, c) = f17[c];
       });
 }
 

@@ -38,6 +38,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -108,7 +109,8 @@ class FractureFlow {
  private:
   // Per gathered point: the doubles of a record (pack()), in this order.
   enum Slot { kGid, kVol, kAp, kPhat, kC, kG, kBulkFixed, kPold, kRegions, kNnb, kX };
-  static constexpr int kRecord = kX + 2 * Dim;  // then x[Dim], n[Dim]
+  static constexpr int kRecord = kX + 2 * Dim;    // then x[Dim], n[Dim]
+  static constexpr double kConductanceCap = 1e8;  // assemble()
 
   void gather(const Scalars& phat, const Scalars& C) {
     auto& p = disc_.points;
@@ -244,14 +246,31 @@ class FractureFlow {
     diag_.assign(n, 0.0);
     rhs_.assign(n, 0.0);
     source_.assign(n, 0.0);
+    // Conditioning: a wide-open crack's conductances exceed V C_f / dt by more than the 16
+    // digits of a double, and the pressure level of a network component (set by its storage)
+    // would be lost in round-off (an exactly singular LU). Conductances are capped at
+    // kConductanceCap times the smallest storage-plus-exchange term of the network: at the
+    // cap the pressure evens out over 1e4 points along the crack within one step, so the cap
+    // changes what the crack does by less than the step's own error. Water is conserved
+    // whatever the cap (contents come from the flows actually used).
+    double floor = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < n; ++i)
+      floor = std::min(floor, r(i, kVol) * (storage_[i] / dt + gexch_[i]));
+    const double cap = kConductanceCap * floor;
     for (int i = 0; i < n; ++i) {
       double s = 0;
       for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e) {
-        lambda_[e] = 0.5 * (kappa[i] + kappa[adj_[e]]);
+        lambda_[e] = std::min(0.5 * (kappa[i] + kappa[adj_[e]]), cap);
         s += lambda_[e];
       }
       const double v = r(i, kVol);
       diag_[i] = v * storage_[i] / dt + v * gexch_[i] + s;
+      if (!std::isfinite(diag_[i]) || !std::isfinite(r(i, kPold)) || !std::isfinite(r(i, kPhat)))
+        throw CollectiveError("Error, fracture point " + std::to_string(gid_[i]) + " at (" +
+                              std::to_string(r(i, kX)) + ", " + std::to_string(r(i, kX + 1)) +
+                              ") has a non-finite aperture or pressure (aperture " +
+                              std::to_string(r(i, kAp)) + " m, p_f " + std::to_string(r(i, kPold)) +
+                              " Pa): the run has become unstable.");
       rhs_[i] = v * storage_[i] / dt * r(i, kPold) + v * gexch_[i] * r(i, kPhat);
     }
     // Conditions: sources [m^3/s] spread by volume over their network points at t; prescribed

@@ -87,7 +87,10 @@ class SolidSolver : public Mechanics {
     if (face_pressure())
       crack_ = Vectors("mupm::crack_force", p.n_owned, Dim);
     if (set_.fracture.flow && !set_.fracture.face_pressure)  // eq 17 (kernels/solid.hpp)
+    {
       st_.P1f = Vectors("mupm::fracture_part_of_P1", p.size(), Dim * Dim);
+      st_.water_force = Vectors("mupm::eq17_force", p.n_owned, Dim + R);
+    }
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", breaks() ? p.size() : p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
@@ -219,7 +222,7 @@ class SolidSolver : public Mechanics {
     forces(t + dt);
     w[0] += 0.5 * power();  // new forces (second half)
     w[1] = dt * damping_power();
-    w[2] = pore_power();
+    w[2] = pore_power() + eq17_power();
     keep_applied();
     if (breaks()) {
       const Breakage br = break_bonds(p, disc_.bonds, set_.fracture.critical_energy, st_.max_energy,
@@ -534,6 +537,28 @@ class SolidSolver : public Mechanics {
         "mupm::Solid::pore_work", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& acc) {
           acc += vol(i) * sr(i) * 0.5 * (ps(i) + ps_old(i)) * (vs(i) - old(i));
+        },
+        w);
+    return w;
+  }
+
+  // Power of eq 17's crack-water forces on this step's increment (this rank's points), with the
+  // forces at the step's end (rectangle rule: first order, and nothing to keep for a restart):
+  // the work the crack's water does on the skeleton, booked with the pore work (eq 140).
+  double eq17_power() const {
+    if (st_.water_force.extent(0) == 0)
+      return 0.0;
+    const auto& p = disc_.points;
+    auto fw = st_.water_force, du = du_;
+    auto vol = p.volume;
+    auto fixed = p.fixed;
+    double w = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::eq17_work", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          for (int c = 0; c < Dim + R; ++c)
+            if (!(fixed(i) & (1u << c)))
+              acc += fw(i, c) * du(i, c) * vol(i);
         },
         w);
     return w;
