@@ -237,13 +237,7 @@ class FluidSolver : public Module {
   // Water mass in the body [kg]: rho_w sum_i V_i m_i.
   double fluid_mass() const {
     const auto& p = disc_.points;
-    auto m = p.fluid_content, vol = p.volume;
-    double s = 0;
-    Kokkos::parallel_reduce(
-        "mupm::Fluid::mass", range(0, p.n_owned),
-        KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += m(i) * vol(i); }, s);
-    MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    return prm_.water_density * s;
+    return prm_.water_density * volume_integral(p.fluid_content, p.volume, p.n_owned, comm_);
   }
 
   // sum_i V_i psi(p_i) [J].

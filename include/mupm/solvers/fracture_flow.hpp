@@ -81,13 +81,7 @@ class FractureFlow {
   // Water in the fracture spaces [kg]: rho_w sum_i V_i content_i.
   double mass() const {
     const auto& p = disc_.points;
-    auto m = p.pf_content, vol = p.volume;
-    double s = 0;
-    Kokkos::parallel_reduce(
-        "mupm::FractureFlow::mass", range(0, p.n_owned),
-        KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += m(i) * vol(i); }, s);
-    MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    return fluid_.water_density * s;
+    return fluid_.water_density * volume_integral(p.pf_content, p.volume, p.n_owned, comm_);
   }
 
   // One step t -> t + dt (header). phat: the bulk pressure of the explicit step without the

@@ -4,9 +4,13 @@
 #ifndef MUPM_MODULE_HPP
 #define MUPM_MODULE_HPP
 
+#include <mpi.h>
+
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "mupm/core/types.hpp"
 
 namespace mupm {
 
@@ -80,6 +84,17 @@ class Mechanics : public Module {
   // Bond pairs broken since t = 0 (the same number on every rank).
   virtual long long broken_pairs() const { return 0; }
 };
+
+// sum_i f_i V_i over the owned points of all ranks (e.g. a water content times the volume).
+inline double volume_integral(const Scalars& f, const Scalars& vol, std::size_t n_owned,
+                              MPI_Comm comm) {
+  double s = 0;
+  Kokkos::parallel_reduce(
+      "mupm::volume_integral", range(0, n_owned),
+      KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += f(i) * vol(i); }, s);
+  MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm);
+  return s;
+}
 
 }  // namespace mupm
 
