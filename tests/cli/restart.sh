@@ -4,7 +4,8 @@
 # whose crack grows by bond breakage from step ~200 of 440 (restarted at 220, in the middle of
 # the growth): a straight run on 1 rank equals half the steps on 2 ranks followed by the rest on
 # 1 rank x 2 threads (fields and checkpoints compared byte for byte; for the crack, the broken
-# bonds too); the crack also in a saturated, hydro-mechanical plate.
+# bonds too); the crack also in a saturated, hydro-mechanical plate, and with water in the crack
+# (fracture flow, both crack-water force models), whose water balance is checked too.
 source "$(dirname "$0")/common.sh"
 # make_input XML FOLDER STEPS RESTART [SED_EXPR]: the input (a path in the source tree) with
 # its folder, step count and restart file replaced, a field output every 20 steps, and SED_EXPR.
@@ -72,4 +73,17 @@ check fracture-hm tests/cli/fracture_small.xml 440 15 's|value="Micropolar Solid
 # The same with water in the crack: p_f, injection at the notch's mouth, exchange, crack
 # pressure on the faces (the network solve is gathered and serial: bit for bit on any ranks).
 check fracture-flow tests/cli/fracture_small.xml 440 16 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|; s|<Parameter name="Bond Breakage"|<Parameter name="Fracture Flow" type="bool" value="true"/><Parameter name="Bond Breakage"|; s|<ParameterList name="Pre-Cracks">|<ParameterList name="Regions"><ParameterList name="mouth"><Parameter name="Min" type="Array(double)" value="{0, 0.045}"/><Parameter name="Max" type="Array(double)" value="{0.005, 0.055}"/></ParameterList></ParameterList><ParameterList name="Pre-Cracks">|; s|<ParameterList name="Boundary Conditions">|<ParameterList name="Boundary Conditions"><ParameterList name="mouth"><Parameter name="Type" type="string" value="Fracture Source"/><Parameter name="Region" type="string" value="mouth"/><Parameter name="Value" type="double" value="5e-5"/></ParameterList>|'
+# Water (bulk + fracture + injected) over the straight run, whose crack and network grow.
+"$PYTHON" - <<'PY'
+import csv
+rows = list(csv.DictReader(open("fracture-flow-straight/time_series.csv")))
+worst = max(abs(float(r["fluid_mass_error"])) / float(r["fluid_mass"]) for r in rows)
+first, last = float(rows[1]["fracture_points"]), float(rows[-1]["fracture_points"])
+assert last > first and float(rows[-1]["fluid_inflow_mouth"]) > 0, (first, last)
+assert worst < 1e-12, worst
+print(f"restart fracture-flow: water conserved to {worst:.1e} of the body's while the network "
+      f"grew from {first:.0f} to {last:.0f} points")
+PY
+# And with the paper's eq 17 for the crack water's force.
+check fracture-eq17 tests/cli/fracture_small.xml 440 16 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|; s|<Parameter name="Bond Breakage"|<Parameter name="Fracture Flow" type="bool" value="true"/><Parameter name="Crack Water Force" type="string" value="Eq 17"/><Parameter name="Bond Breakage"|; s|<ParameterList name="Pre-Cracks">|<ParameterList name="Regions"><ParameterList name="mouth"><Parameter name="Min" type="Array(double)" value="{0, 0.045}"/><Parameter name="Max" type="Array(double)" value="{0.005, 0.055}"/></ParameterList></ParameterList><ParameterList name="Pre-Cracks">|; s|<ParameterList name="Boundary Conditions">|<ParameterList name="Boundary Conditions"><ParameterList name="mouth"><Parameter name="Type" type="string" value="Fracture Source"/><Parameter name="Region" type="string" value="mouth"/><Parameter name="Value" type="double" value="5e-5"/></ParameterList>|'
 echo "restart: passed"
