@@ -297,7 +297,7 @@ TEST(FractureFlow, Eq17ReplacesThePorePressureOnFractureBonds) {
     SolidState<2> st;
     st.allocate(p.size(), p.n_owned);
     if (eq17)
-      st.P1f = Vectors("P1f", p.size(), 4);
+      st.allocate_eq17(p.size(), p.n_owned);
     Kokkos::deep_copy(p.p, eq17 ? 0.0 : p0);
     Kokkos::deep_copy(p.pf, eq17 ? p0 : 0.0);
     Kokkos::deep_copy(p.pf_saturation, eq17 ? 1.0 : 0.0);

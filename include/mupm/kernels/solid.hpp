@@ -99,6 +99,11 @@ struct SolidState {
     energy = Scalars("mupm::strain_energy", n_owned);
     pstar = Scalars("mupm::solid_pore_pressure", n_owned);
   }
+  // Crack Water Force = Eq 17 (fracture flow): P1f and water_force.
+  void allocate_eq17(std::size_t n_all, std::size_t n_owned) {
+    P1f = Vectors("mupm::fracture_part_of_P1", n_all, Dim * Dim);
+    water_force = Vectors("mupm::eq17_force", n_owned, Dim + R);
+  }
   // What pass 2 reads from the neighbours, besides u and theta.
   std::vector<Vectors> pass2_ghosts() const {
     std::vector<Vectors> g{eps, kappa, P1, P2, as_vectors(w0)};

@@ -87,10 +87,7 @@ class SolidSolver : public Mechanics {
     if (face_pressure())
       crack_ = Vectors("mupm::crack_force", p.n_owned, Dim);
     if (set_.fracture.flow && !set_.fracture.face_pressure)  // eq 17 (kernels/solid.hpp)
-    {
-      st_.P1f = Vectors("mupm::fracture_part_of_P1", p.size(), Dim * Dim);
-      st_.water_force = Vectors("mupm::eq17_force", p.n_owned, Dim + R);
-    }
+      st_.allocate_eq17(p.size(), p.n_owned);
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", breaks() ? p.size() : p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
