@@ -330,7 +330,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
           //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
           double t[Dim], m[R], cf[Dim] = {};
-          if (eq17 && srf(i) > 0 && srf(j) > 0)  // eq 17: the fracture bond's water is p_f's
+          if (eq17 && srf(i) > 0 && srf(j) > 0) {  // eq 17: the fracture bond's water is p_f's
             for (int a = 0; a < Dim; ++a) {
               double ci = 0, cj = 0;
               for (int k = 0; k < Dim; ++k) {
@@ -339,7 +339,6 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
               }
               cf[a] = ci + cj;
             }
-          if (eq17) {
             double xc[R];
             cross<Dim>(xi, cf, xc);
             for (int a = 0; a < Dim; ++a)

@@ -174,7 +174,6 @@ class FluidSolver : public Module {
   // A solid initialized afterwards computes tr(eps): then call reset_strain_reference().
   void initialize(double t, bool restarted) {
     auto& p = disc_.points;
-    bool init_content = false;
     auto regions = p.regions;
     auto fixed = p.fixed, vol = p.volume;
     for (std::size_t k = 0; k < bcs_.size(); ++k) {
@@ -199,7 +198,6 @@ class FluidSolver : public Module {
     if (!restarted) {
       set_pressure(t, p.p);
       energy_.stored0 = stored_energy();
-      init_content = true;
       fluid_constitutive(p, prm_, st_);
       auto pw = p.p, phi = p.porosity, sr = p.saturation, m = p.fluid_content;
       auto vs = p.vol_strain, ref = p.vol_strain_ref;
@@ -209,9 +207,8 @@ class FluidSolver : public Module {
             m(i) = phi(i) * sr(i) * (1 + pw(i) * inv_kw);
             ref(i) = vs(i);
           });
-    }
-    if (init_content)
       mass0_ = fluid_mass();
+    }
     evaluate();
   }
 

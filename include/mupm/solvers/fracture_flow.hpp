@@ -101,7 +101,7 @@ class FractureFlow {
   }
 
  private:
-  // Per gathered point: the doubles of a record (pack()), in this order.
+  // Per gathered point: the doubles of a record (gather()), in this order.
   enum Slot { kGid, kVol, kAp, kPhat, kC, kG, kBulkFixed, kPold, kRegions, kNnb, kX };
   static constexpr int kRecord = kX + 2 * Dim;    // then x[Dim], n[Dim]
   static constexpr double kConductanceCap = 1e8;  // assemble()
