@@ -58,6 +58,8 @@ struct Points {
   Scalars pf, pf_rate;    // fracture pressure and its rate (fracture network points)
   Scalars pf_saturation;  // S_rf of the fracture space; > 0 exactly on the fracture network
   Scalars pf_content;     // water that entered the point's fracture space, per unit volume
+  Scalars pf_aperture;    // mean opening c_f at the last fracture-flow step (volume change)
+  Scalars pf_modulus;     // M_f [Pa/m]: p_f* = p_f - M_f (c_f - pf_aperture) (undrained split)
   Scalars porosity, saturation;
   Scalars rel_perm;             // relative permeability k_r (eq 56)
   Vectors darcy_flux;           // q [m/s] (eq 54) [n][Dim]
@@ -165,6 +167,8 @@ struct Points {
     f(p.pf_rate,           FieldSpec{"fracture_pressure_rate", 1, kCheckpoint});
     f(p.pf_saturation,     FieldSpec{"fracture_saturation", 1, kState | kGhosted});
     f(p.pf_content,        FieldSpec{"fracture_fluid_content", 1, kState});
+    f(p.pf_aperture,       FieldSpec{"fracture_storage_aperture", 1, kCheckpoint});
+    f(p.pf_modulus,        FieldSpec{"fracture_undrained_modulus", 1, kCheckpoint});
     f(p.porosity,          FieldSpec{"porosity", 1, kState, "Porosity"});
     f(p.saturation,        FieldSpec{"saturation", 1, kState, "Saturation"});
     f(p.rel_perm,          FieldSpec{"relative_permeability", 1, kState});

@@ -66,8 +66,30 @@ void compute_damage(const Bonds& bonds, const Points<Dim>& p, double critical_da
 // paper gives no n; a point's broken bonds all cross the crack, so their sum points across it:
 // n_i = sum_broken xi / |sum_broken xi| (for a point on a straight crack's face, exactly the
 // normal by symmetry). Eq 39 averages c over the broken bonds with omega = 1:
-// a_i = sum_broken c V_j / sum_broken V_j, and a negative mean (faces pressed together) is 0.
-// Points without broken bonds get 0. Needs u current on the ghosts.
+// mean_opening = sum_broken c V_j / sum_broken V_j (negative when the faces are pressed
+// together; 0 without broken bonds), and the aperture a_i is its positive part. Needs u
+// current on the ghosts.
+template <int Dim, class Offsets, class Neighbors, class Intact, class X, class U, class Vol>
+KOKKOS_INLINE_FUNCTION double mean_opening(const Offsets& offsets, const Neighbors& neighbor,
+                                           const Intact& intact, const X& x, const U& u,
+                                           const Vol& volume, std::size_t i) {
+  double n[Dim];
+  if (!crack_normal<Dim>(offsets, neighbor, intact, x, i, n))
+    return 0.0;
+  double sum = 0, vsum = 0;
+  for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
+    if (intact(b))
+      continue;
+    const int j = neighbor(b);
+    double c = 0;
+    for (int d = 0; d < Dim; ++d)
+      c += (u(j, d) - u(i, d)) * n[d];  // eq 38
+    sum += c * volume(j);
+    vsum += volume(j);
+  }
+  return sum / vsum;  // eq 39
+}
+
 template <int Dim>
 void compute_aperture(const Bonds& bonds, const Points<Dim>& p) {
   auto offsets = bonds.offsets;
@@ -79,23 +101,9 @@ void compute_aperture(const Bonds& bonds, const Points<Dim>& p) {
   auto aperture = p.aperture;
   Kokkos::parallel_for(
       "mupm::Fracture::aperture", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-        double a = 0;
-        double n[Dim];
-        if (damage(i) > 0 && crack_normal<Dim>(offsets, neighbor, intact, x, i, n)) {
-          double sum = 0, vsum = 0;
-          for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
-            if (intact(b))
-              continue;
-            const int j = neighbor(b);
-            double c = 0;
-            for (int d = 0; d < Dim; ++d)
-              c += (u(j, d) - u(i, d)) * n[d];  // eq 38
-            sum += c * volume(j);
-            vsum += volume(j);
-          }
-          a = sum / vsum > 0 ? sum / vsum : 0.0;  // eq 39
-        }
-        aperture(i) = a;
+        const double c =
+            damage(i) > 0 ? mean_opening<Dim>(offsets, neighbor, intact, x, u, volume, i) : 0.0;
+        aperture(i) = c > 0 ? c : 0.0;
       });
 }
 

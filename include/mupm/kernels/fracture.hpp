@@ -38,11 +38,13 @@ struct FractureParams {
   double critical_damage = 0.3;  // D_cr: fracture point at D >= D_cr (eq 104)
   bool effective_state = true;   // bond energy of the effective (true) or total force state
   // Fracture flow (include/mupm/kernels/fracture_flow.hpp).
-  bool flow = false;            // p_f on the fracture network, exchange, crack pressure on faces
-  double viscosity = 1e-3;      // mu_w [Pa s] of the cubic law
-  double min_aperture = 1e-6;   // lower bound of the aperture in conductance and storage [m]
-  double crossing_measure = 0;  // m_c of the crack-pressure force (crossing_measure<Dim>)
-  bool face_pressure = true;    // p_f on the crack's faces (true) or on fracture bonds (eq 17)
+  bool flow = false;             // p_f on the fracture network, exchange, crack pressure on faces
+  double viscosity = 1e-3;       // mu_w [Pa s] of the cubic law
+  double min_aperture = 1e-6;    // lower bound of the aperture in conductance and storage [m]
+  double water_modulus = 2.2e9;  // K_w [Pa] (Fluid->Fluid Bulk Modulus): the crack water's
+                                 // stiffness in the solid's stable-step estimate
+  double crossing_measure = 0;   // m_c of the crack-pressure force (crossing_measure<Dim>)
+  bool face_pressure = true;     // p_f on the crack's faces (true) or on fracture bonds (eq 17)
 };
 
 // W_cr of eq 36 (3D) and its plane-strain analogue (header), per pair of unit volumes.

@@ -33,10 +33,13 @@
 //
 // Storage: the paper sets phi = 0 in the fracture space (eq 19) and eq 144 divides by
 // phi dS_rf/dp_f, zero when saturated. We give the water in the crack's volume its
-// compressibility: C_f,i = phi_f,i (dS_rf/dp_f + S_rf / K_w), phi_f,i with the aperture bounded
-// below by Fracture->Minimum Aperture (a closed crack keeps a storage and a conductance). As in
-// the paper there is no volume coupling in the fracture space (eq 19: "the volume coupling term
-// vanishes"): an opening crack does not draw water by its opening.
+// compressibility: C_f,i = phi_f,i (dS_rf/dp_f + S_rf / K_w), with the storage aperture
+// c_i + a_min in phi_f,i, c_i the signed mean opening (kernels/damage.hpp; Fracture->Minimum
+// Aperture: a closed crack keeps a film of water, so a storage). The conductance takes
+// max(a_i, a_min) (a closed crack keeps a conductance). Unlike eq 19 ("the volume coupling term
+// vanishes") the crack's opening is booked: an opening dc_i makes room for S_rf dc_i / (n_i dx)
+// of water per unit volume (solvers/fracture_flow.hpp says why: without it injected water can
+// only compress).
 //
 // Exchange (eq 19; eq 118 has the order flipped): from the bulk into the fracture, per unit
 // volume of the point, Q_s = (k_r k / mu_w) (p_w - p_f) / l_x * A / V with l_x = dx/2 and
@@ -76,17 +79,45 @@ double crossing_measure(double horizon, double thickness) {
     return M_PI * thickness * std::pow(horizon, 4) / 8.0;
 }
 
-// Adds the crack's water pressure on its faces to the force density `body` of the owned points
-// (header): over every broken bond, -p_c V_j xi / m_c. A point is in the fracture network where
-// its fracture_saturation is > 0; p_f and fracture_saturation must be current on the ghosts.
+// The crack water's pressure the solid applies, undrained (the fracture's analogue of the bulk's
+// p* = p - (S_r/C) d(tr eps), eq 141's split): on a network point
+//   p_f* = p_f - M_f (c - c_ref),   M_f = S_rf / (C_f n_i dx)   [Pa/m],
+// c the point's mean opening now (kernels/damage.hpp), c_ref and p_f those of the last fracture-
+// flow step (Points::pf_aperture, pf), M_f its undrained modulus (Points::pf_modulus, written by
+// the fracture-flow step; 0 where p_f is prescribed). This is the p_f the next fracture-flow step
+// starts from before any flow (solvers/fracture_flow.hpp), so the solid sees the crack water's
+// stiffness at the displacement it is at. Without it the force used the p_f of one step earlier:
+// a lagged spring of stiffness K_w/a_min, which grew without bound in Example 1 unless dt was
+// below ~5e-8 s (measured). Off the network p_f* = p_f. Owned points; u current on the ghosts.
 template <int Dim>
-void crack_pressure_force(const Bonds& bonds, const Points<Dim>& pts, double m_c,
+void undrained_fracture_pressure(const Bonds& bonds, const Points<Dim>& pts, const Scalars& out) {
+  auto offsets = bonds.offsets;
+  auto neighbor = bonds.neighbor;
+  auto intact = bonds.intact;
+  auto x = pts.x, u = pts.u, vol = pts.volume;
+  auto pf = pts.pf, sat = pts.pf_saturation, ref = pts.pf_aperture, mod = pts.pf_modulus;
+  Kokkos::parallel_for(
+      "mupm::Fracture::undrained_pressure", range(0, pts.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i) {
+        double p = pf(i);
+        if (sat(i) > 0 && mod(i) != 0)
+          p -= mod(i) * (mean_opening<Dim>(offsets, neighbor, intact, x, u, vol, i) - ref(i));
+        out(i) = p;
+      });
+}
+
+// Adds the crack's water pressure on its faces to the force density `body` of the owned points
+// (header): over every broken bond, -p_c V_j xi / m_c, p_c from the points' pressures `pf`. A
+// point is in the fracture network where its fracture_saturation is > 0; pf and
+// fracture_saturation must be current on the ghosts.
+template <int Dim>
+void crack_pressure_force(const Bonds& bonds, const Points<Dim>& pts, const Scalars& pf, double m_c,
                           const Vectors& body) {
   auto offsets = bonds.offsets;
   auto neighbor = bonds.neighbor;
   auto intact = bonds.intact;
   auto x = pts.x, vol = pts.volume;
-  auto pf = pts.pf, sat = pts.pf_saturation;
+  auto sat = pts.pf_saturation;
   const double inv_m = 1.0 / m_c;
   Kokkos::parallel_for(
       "mupm::Fracture::crack_pressure", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {

@@ -7,7 +7,8 @@
 // a^2 K_w / (12 mu_w): 1.8e3 m^2/s for a = 0.1 mm, so a forward-Euler step on dx = 2.5 mm would
 // have to stay below ~1e-9 s, a thousandth of the solid's step. p_f is advanced by backward
 // Euler instead, with the exchange implicit on both sides:
-//   V_i C_f,i (p_i - p_i^n)/dt = sum_j Lambda_ij (p_j - p_i) + V_i G'_i (p^_i - p_i) + Q_i,
+//   V_i C_f,i (p_i - p_i^n)/dt = sum_j Lambda_ij (p_j - p_i) + V_i G'_i (p^_i - p_i) + Q_i
+//                                 - V_i S_rf,i (phi_f,i - phi_f,i^n)/dt,
 // p^_i the bulk pressure the bulk's explicit step would reach without the exchange and
 // G'_i = G_i C_i / (C_i + dt G_i) (C_i the bulk storage): eliminating the bulk's p_w^{n+1} from
 // C_i (p_w^{n+1} - p_w^n) = (explicit terms) - dt G_i (p_w^{n+1} - p_i) gives exactly this,
@@ -15,6 +16,24 @@
 // pressure G' = G and p^ the prescribed value. The bulk takes X_i = dt V_i G'_i (p^_i - p_i) out
 // as a sink (include/mupm/solvers/fluid_solver.hpp), the fracture takes it in: fluid mass is
 // conserved to round-off. C_f and S_rf are those of p_f^n (linearized over the step).
+//
+// The crack's volume change (deviation from eq 19, which has none). The last term is the water
+// the crack's opening makes room for: phi_f = (c_f + a_min)/(n_i dx) is the fracture space per
+// unit volume (kernels header), c_f the point's mean opening (kernels/damage.hpp, eq 39 before
+// its positive part is taken: negative when the faces are pressed together), phi_f^n that of
+// the last step's opening (Points::pf_aperture, over the same n_i, so a change of n_i is no
+// volume change). a_min is a film of water in the closed crack: faces pressed into it raise p_f
+// and are pushed back, as opened ones lower it. (With the aperture's positive part in place of
+// c_f, the faces closed onto each other without resistance while the injected water pushed
+// them apart, and p_f and the bulk's p swung by MPa from step to step: measured in Example 1.)
+// The film is bounded below by a_min/100 to keep a storage. It is the fracture's analogue of
+// the bulk's S_r d(tr eps) (eq 141): without it, water injected into a crack could only
+// compress (p_f rises by K_w/phi_f per unit content, ~1e3 times the skeleton's stiffness),
+// and an opening crack would not draw water. Held at fixed content, an opening da lowers p_f by
+// K_w da/a (saturated): the crack's water is a stiff spring between its faces, explicit in the
+// solid step (the crack force uses p_f of the last fluid step), resolved when the step stays
+// below ~2/omega, omega^2 = 2 K_w/(rho n_i dx a) (two faces of mass rho V on a spring
+// K_w V/(n_i dx (c_f + a_min))); hence a_min also bounds this stiffness.
 //
 // The network is small (the fracture points of a 2D body lie on lines, of a 3D body on
 // surfaces): every rank gathers it whole (its points' positions, apertures, normals, bulk
@@ -29,8 +48,9 @@
 // (on a point of prescribed p_f the reservoir supplies V C_f dp minus that, counted as the
 // condition's inflow). Summed over the network the bond flows cancel pair by pair, so
 // fracture water = injected + exchanged + supplied, to round-off. A point joins the network
-// (becomes a fracture point) with p_f = its bulk p_w and no content: the crack's new volume at
-// that pressure is not booked (no volume coupling in the fracture space, eq 19).
+// (becomes a fracture point) with p_f = its bulk p_w, no content and phi_f^n = its phi_f: the
+// crack's volume at joining is taken as filled at that pressure (not booked as water), its
+// opening from then on is.
 #ifndef MUPM_SOLVERS_FRACTURE_FLOW_HPP
 #define MUPM_SOLVERS_FRACTURE_FLOW_HPP
 
@@ -102,7 +122,21 @@ class FractureFlow {
 
  private:
   // Per gathered point: the doubles of a record (gather()), in this order.
-  enum Slot { kGid, kVol, kAp, kPhat, kC, kG, kBulkFixed, kPold, kRegions, kNnb, kX };
+  enum Slot {
+    kGid,
+    kVol,
+    kAp,
+    kOpen,
+    kOpenRef,
+    kPhat,
+    kC,
+    kG,
+    kBulkFixed,
+    kPold,
+    kRegions,
+    kNnb,
+    kX
+  };
   static constexpr int kRecord = kX + 2 * Dim;    // then x[Dim], n[Dim]
   static constexpr double kConductanceCap = 1e8;  // assemble()
 
@@ -121,10 +155,13 @@ class FractureFlow {
         for (int d = 0; d < Dim; ++d)
           nrm[d] = 0;
       const bool fresh = !(p.pf_saturation(i) > 0);
+      const double open = mean_opening<Dim>(b.offsets, b.neighbor, b.intact, p.x, p.u, p.volume, i);
       const BondIndex e0 = b.offsets(i), e1 = b.offsets(i + 1);
       const double r[kX] = {double(p.gid(i)),
                             p.volume(i),
                             p.aperture(i),
+                            open,
+                            fresh ? open : p.pf_aperture(i),
                             phat(i),
                             C(i),
                             g0 * p.rel_perm(i),
@@ -200,6 +237,8 @@ class FractureFlow {
     adj_.clear();
     std::vector<double> kappa(n, 0.0);
     storage_.assign(n, 0.0);
+    opening_.assign(n, 0.0);
+    rows_.assign(n, 1);
     gexch_.assign(n, 0.0);
     for (int i = 0; i < n; ++i) {
       std::vector<int> js;
@@ -228,11 +267,14 @@ class FractureFlow {
       }
       adj_first_.push_back((long long)adj_.size());
       const double a = std::max(r(i, kAp), amin);
-      const double area = r(i, kVol) / (rows * dx);                // A_i
-      kappa[i] = m > 0 ? a * a * a * area / (6.0 * mu * m) : 0.0;  // kernels header
-      const double phi_f = a / (rows * dx);
-      const double pold = r(i, kPold);
-      storage_[i] = phi_f * (vg.dsaturation_dp(pold) + vg.saturation(pold) * inv_kw);
+      const double area = r(i, kVol) / (rows * dx);                   // A_i
+      kappa[i] = m > 0 ? a * a * a * area / (6.0 * mu * m) : 0.0;     // kernels header
+      const double film = std::max(amin + r(i, kOpen), 0.01 * amin);  // header
+      const double phi_f = film / (rows * dx);
+      const double pold = r(i, kPold), sat = vg.saturation(pold);
+      storage_[i] = phi_f * (vg.dsaturation_dp(pold) + sat * inv_kw);
+      opening_[i] = sat * (r(i, kOpen) - r(i, kOpenRef)) / (rows * dx);  // S_rf d(phi_f)
+      rows_[i] = rows;
       const double G = r(i, kG), Cb = r(i, kC);
       gexch_[i] = r(i, kBulkFixed) != 0 ? G : (Cb > 0 ? G * Cb / (Cb + dt * G) : 0.0);
     }
@@ -265,7 +307,8 @@ class FractureFlow {
                               ") has a non-finite aperture or pressure (aperture " +
                               std::to_string(r(i, kAp)) + " m, p_f " + std::to_string(r(i, kPold)) +
                               " Pa): the run has become unstable.");
-      rhs_[i] = v * storage_[i] / dt * r(i, kPold) + v * gexch_[i] * r(i, kPhat);
+      rhs_[i] =
+          v * storage_[i] / dt * r(i, kPold) + v * gexch_[i] * r(i, kPhat) - v * opening_[i] / dt;
     }
     // Conditions: sources [m^3/s] spread by volume over their network points at t; prescribed
     // p_f at t + dt (later conditions win).
@@ -407,7 +450,7 @@ class FractureFlow {
       exch[i] = dt * v * gexch_[i] * (r(i, kPhat) - x_[i]);
       gain[i] = dt * (flow + source_[i]) + exch[i];
       if (held_[i] >= 0) {
-        const double stored = v * storage_[i] * (x_[i] - r(i, kPold));
+        const double stored = v * (storage_[i] * (x_[i] - r(i, kPold)) + opening_[i]);
         supplied[held_[i]] += stored - gain[i];
         gain[i] = stored;
       }
@@ -421,6 +464,12 @@ class FractureFlow {
       if (i < p.n_owned) {
         p.pf_rate(i) = (x_[k] - r(k, kPold)) / dt;
         p.pf_content(i) += gain[k] / r(k, kVol);
+        p.pf_aperture(i) = r(k, kOpen);
+        // The undrained modulus M_f = S_rf/(C_f n_i dx) of the solid's p_f* (kernels header):
+        // 0 on a point of prescribed p_f.
+        p.pf_modulus(i) =
+            held_[k] >= 0 ? 0.0
+                          : vg.saturation(r(k, kPold)) / (storage_[k] * rows_[k] * disc_.grid.dx);
         sink(i) = exch[k] / (dt * r(k, kVol));
       }
       p.pf(i) = x_[k];
@@ -436,8 +485,9 @@ class FractureFlow {
   std::vector<double> inflow_;
   // The gathered network (global-id order) and its system.
   std::vector<long long> gid_, nb_, nb_first_, adj_first_;
-  std::vector<double> rec_, lambda_, diag_, rhs_, source_, storage_, gexch_, x_, held_value_;
-  std::vector<int> adj_, held_;
+  std::vector<double> rec_, lambda_, diag_, rhs_, source_, storage_, opening_, gexch_, x_,
+      held_value_;
+  std::vector<int> adj_, held_, rows_;
   long long last_size_ = 0;
   int last_bandwidth_ = 0;
 };

@@ -84,8 +84,10 @@ class SolidSolver : public Mechanics {
     rho_ = Scalars("mupm::density", p.n_owned);
     inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
     body_ = Vectors("mupm::body_force", p.n_owned, Dim);
-    if (face_pressure())
+    if (face_pressure()) {
       crack_ = Vectors("mupm::crack_force", p.n_owned, Dim);
+      pf_star_ = Scalars("mupm::undrained_fracture_pressure", p.size());
+    }
     if (set_.fracture.flow && !set_.fracture.face_pressure)  // eq 17 (kernels/solid.hpp)
       st_.allocate_eq17(p.size(), p.n_owned);
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
@@ -414,14 +416,53 @@ class SolidSolver : public Mechanics {
     Kokkos::deep_copy(p.vol_strain_ref, 0.0);
     const BondWork work = st_.work;
     st_.work = BondWork::Off;  // the iterates are no motion of the body
+    // With the crack's water on its faces the operator includes its undrained stiffness M_f
+    // (kernels/fracture_flow.hpp): its linear part (p_f = 0 at c_ref = 0), and on a fracture
+    // point not yet in the network the modulus it will join with, K_w / a_min (saturated, closed:
+    // a film a_min). The crack water's stiffness K_w / a_min is what limits the step of a
+    // fluid-driven crack (Example 1 at 66 x 66, K_w = 2.2 GPa, a_min = 0.1 mm: stable at 0.4 us,
+    // unstable at 0.95 us, the skeleton's own limit being 1.9 us).
+    const bool crack = face_pressure();
+    Scalars keep[4];
+    if (crack) {
+      Scalars fields[4] = {p.pf, p.pf_saturation, p.pf_modulus, p.pf_aperture};
+      for (int k = 0; k < 4; ++k) {
+        keep[k] = Scalars("keep", n);
+        Kokkos::deep_copy(keep[k], fields[k]);
+      }
+      const double joins = set_.fracture.water_modulus / set_.fracture.min_aperture;
+      auto pf = p.pf, sat = p.pf_saturation, mod = p.pf_modulus, ref = p.pf_aperture;
+      auto frac = p.fracture;
+      Kokkos::parallel_for(
+          "mupm::Solid::crack_stiffness", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            if (frac(i) && !(sat(i) > 0)) {
+              sat(i) = 1.0;
+              mod(i) = joins;
+            }
+            pf(i) = 0;
+            ref(i) = 0;
+          });
+      disc_.dist.refresh({as_vectors(p.pf_saturation)});
+    }
     const Operator op{p.u, p.theta, st_.force, st_.moment, rho_, inertia_, p.fixed};
     const double lambda = largest_eigenvalue(
         op, Dim + R, p.n_owned, p.gid, p.volume,
         [&] {
           disc_.dist.refresh({p.u, p.theta});
           solid_forces(disc_, prm_, law_, st_);
+          if (crack) {
+            undrained_fracture_pressure(disc_.bonds, p, pf_star_);
+            disc_.dist.refresh({as_vectors(pf_star_)});
+            crack_pressure_force(disc_.bonds, p, pf_star_, set_.fracture.crossing_measure,
+                                 st_.force);
+          }
         },
         comm_, iterations);
+    if (crack) {
+      Scalars fields[4] = {p.pf, p.pf_saturation, p.pf_modulus, p.pf_aperture};
+      for (int k = 0; k < 4; ++k)
+        Kokkos::deep_copy(fields[k], keep[k]);
+    }
     Kokkos::deep_copy(p.u, u0);
     Kokkos::deep_copy(p.theta, t0);
     Kokkos::deep_copy(p.p, p0);
@@ -470,8 +511,11 @@ class SolidSolver : public Mechanics {
     solid_forces(disc_, prm_, law_, st_);
     body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
     if (face_pressure()) {  // the crack's water on its faces (kernels/fracture_flow.hpp)
+      // p_f* at this displacement (undrained split, kernels/fracture_flow.hpp), onto the ghosts.
+      undrained_fracture_pressure(disc_.bonds, p, pf_star_);
+      disc_.dist.refresh({as_vectors(pf_star_)});
       Kokkos::deep_copy(crack_, 0.0);
-      crack_pressure_force(disc_.bonds, p, set_.fracture.crossing_measure, crack_);
+      crack_pressure_force(disc_.bonds, p, pf_star_, set_.fracture.crossing_measure, crack_);
       add_to_body(crack_);
     }
     forces_time_ = t;
@@ -641,6 +685,7 @@ class SolidSolver : public Mechanics {
   Scalars rho_, inertia_;
   Vectors body_, couple_, du_;
   Vectors crack_;           // the crack water's force density (Fracture Flow)
+  Scalars pf_star_;         // p_f* of the crack force (owned and ghosts)
   double forces_time_ = 0;  // t of the last forces()
   Vectors f_old_, l_old_;   // forces of the old bond set at a breakage
   Scalars vs_old_;
