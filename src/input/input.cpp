@@ -298,14 +298,17 @@ RCP<ParameterList> valid_parameters() {
     f.set("Crack Water Force", std::string("Face Pressure"),
           "How the crack's water pressure p_f acts on the solid (Fracture Flow). Face "
           "Pressure: p_f pushes the crack's faces apart (central pair forces on the broken "
-          "bonds, p_f per unit face area). Eq 17: as the paper prints it, bonds between two "
-          "fracture points carry -S_rf p_f K^-1 xi in place of -S_r p K^-1 xi; those bonds run "
-          "along the faces, so p_f barely acts across the crack. Derivations and why in "
-          "include/mupm/kernels/fracture_flow.hpp.",
+          "bonds, p_f per unit face area), with the undrained p_f* of the opening the solid is "
+          "at. Eq 17: as the paper prints it, bonds between two fracture points carry -S_rf p_f "
+          "K^-1 xi in place of -S_r p K^-1 xi; those bonds run along the faces, so p_f barely "
+          "acts across the crack (and p_f is that of the last fluid step). Derivations and why "
+          "in include/mupm/kernels/fracture_flow.hpp.",
           crack_water_force_options().validator());
     f.set("Minimum Aperture", 1e-6,
-          "a_min [m]: the aperture of the fracture flow's conductance and storage is at least "
-          "this (a closed crack still conducts and stores a little; the paper gives none).",
+          "a_min [m]: a film of water in the crack (the paper gives none). The conductance "
+          "takes max(a, a_min); the storage the crack's volume a + a_min, whose opening stores "
+          "water. The crack water's stiffness K_w / a_min enters the solid's stable step: a "
+          "small a_min (with a stiff water) means a small step.",
           positive());
   }
   {
