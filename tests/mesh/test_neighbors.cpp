@@ -108,6 +108,18 @@ TEST(Neighbors, BruteForce4Dx) {
   check_against_brute_force(test::box<3>({6, 5, 7}, 4.015), {});
 }
 
+// A horizon that is a whole number of spacings (Example 1 at 66 x 66: delta = 2 dx) puts
+// neighbours exactly on the horizon, on the edges of the search cells: they must be found on
+// every rank count (on 2 ranks 140 such pairs were once lost at the rank boundary).
+TEST(Neighbors, BruteForceWholeSpacings) {
+  auto g = test::box<2>({66, 66}, 2.0, 3.75e-3);  // Example 1's coarse grid, as its input has it
+  g.horizon = 7.5e-3;
+  g.layers = {{{0, 2}, {2, 2}}};
+  check_against_brute_force(g, {});
+  check_against_brute_force(test::box<2>({11, 12}, 3.0, 2.5e-3), {});
+  check_against_brute_force(test::box<3>({6, 5, 7}, 2.0, 3.75e-3), {});
+}
+
 // VALIDATION.md section 1: K11 and the family size of an interior point, in units of dx.
 template <int Dim>
 void check_shape_tensor(double factor, double k11_units, long long n_neighbors) {

@@ -58,7 +58,11 @@ Bonds build_bonds(const Points<Dim>& pts, double horizon, const std::vector<Crac
   bonds.offsets = View1<BondIndex>("mupm::bond_offsets", n_own + 1);
   auto x = pts.x;
 
-  // Bounding box and cells of edge >= horizon.
+  // Bounding box and cells of edge > horizon: a margin of 1e-6 so that a neighbour on the
+  // horizon (within_horizon's 1e-10) is never two cells away by round-off. With edge = horizon,
+  // a horizon of whole spacings (delta = 2 dx) put such neighbours on the cells' edges, and
+  // bonds were lost depending on the bounding box, i.e. on the rank count (140 pairs of
+  // Example 1's 66 x 66 grid on 2 ranks; test Neighbors.BruteForceWholeSpacings).
   double lo[Dim], hi[Dim];
   for (int d = 0; d < Dim; ++d) {
     double mn = 0, mx = 0;
@@ -72,15 +76,16 @@ Bonds build_bonds(const Points<Dim>& pts, double horizon, const std::vector<Crac
     lo[d] = mn;
     hi[d] = mx;
   }
+  const double edge = horizon * (1 + 1e-6);
   Kokkos::Array<double, Dim> lo_a;
   Kokkos::Array<long, Dim> nc;
   long n_cells = 1;
   for (int d = 0; d < Dim; ++d) {
     lo_a[d] = lo[d];
-    nc[d] = n_all == 0 ? 1 : static_cast<long>((hi[d] - lo[d]) / horizon) + 1;
+    nc[d] = n_all == 0 ? 1 : static_cast<long>((hi[d] - lo[d]) / edge) + 1;
     n_cells *= nc[d];
   }
-  const double inv_h = 1.0 / horizon;
+  const double inv_h = 1.0 / edge;
   auto cell_of = KOKKOS_LAMBDA(const std::size_t i, long* c) {
     for (int d = 0; d < Dim; ++d) {
       long k = static_cast<long>((x(i, d) - lo_a[d]) * inv_h);

@@ -29,11 +29,11 @@
 // The film is bounded below by a_min/100 to keep a storage. It is the fracture's analogue of
 // the bulk's S_r d(tr eps) (eq 141): without it, water injected into a crack could only
 // compress (p_f rises by K_w/phi_f per unit content, ~1e3 times the skeleton's stiffness),
-// and an opening crack would not draw water. Held at fixed content, an opening da lowers p_f by
-// K_w da/a (saturated): the crack's water is a stiff spring between its faces, explicit in the
-// solid step (the crack force uses p_f of the last fluid step), resolved when the step stays
-// below ~2/omega, omega^2 = 2 K_w/(rho n_i dx a) (two faces of mass rho V on a spring
-// K_w V/(n_i dx (c_f + a_min))); hence a_min also bounds this stiffness.
+// and an opening crack would not draw water. Held at fixed content, an opening dc lowers p_f by
+// M_f dc, M_f = S_rf/(C_f n_i dx) = K_w/(c_f + a_min) saturated (Points::pf_modulus, written
+// here): the crack's water is a stiff spring between its faces. The solid applies it undrained,
+// p_f* = p_f - M_f (c - c_ref) at the opening it is at (kernels header), and its stable-step
+// estimate includes it (solvers/solid_solver.hpp); hence a_min also bounds the time step.
 //
 // The network is small (the fracture points of a 2D body lie on lines, of a 3D body on
 // surfaces): every rank gathers it whole (its points' positions, apertures, normals, bulk
