@@ -122,21 +122,7 @@ class FractureFlow {
 
  private:
   // Per gathered point: the doubles of a record (gather()), in this order.
-  enum Slot {
-    kGid,
-    kVol,
-    kAp,
-    kOpen,
-    kOpenRef,
-    kPhat,
-    kC,
-    kG,
-    kBulkFixed,
-    kPold,
-    kRegions,
-    kNnb,
-    kX
-  };
+  enum Slot { kGid, kVol, kOpen, kOpenRef, kPhat, kC, kG, kBulkFixed, kPold, kRegions, kNnb, kX };
   static constexpr int kRecord = kX + 2 * Dim;    // then x[Dim], n[Dim]
   static constexpr double kConductanceCap = 1e8;  // assemble()
 
@@ -159,7 +145,6 @@ class FractureFlow {
       const BondIndex e0 = b.offsets(i), e1 = b.offsets(i + 1);
       const double r[kX] = {double(p.gid(i)),
                             p.volume(i),
-                            p.aperture(i),
                             open,
                             fresh ? open : p.pf_aperture(i),
                             phat(i),
@@ -266,8 +251,8 @@ class FractureFlow {
         adj_.push_back(j);
       }
       adj_first_.push_back((long long)adj_.size());
-      const double a = std::max(r(i, kAp), amin);
-      const double area = r(i, kVol) / (rows * dx);                   // A_i
+      const double a = std::max(r(i, kOpen), amin);  // the aperture max(c, 0), at least a_min
+      const double area = r(i, kVol) / (rows * dx);  // A_i
       kappa[i] = m > 0 ? a * a * a * area / (6.0 * mu * m) : 0.0;     // kernels header
       const double film = std::max(amin + r(i, kOpen), 0.01 * amin);  // header
       const double phi_f = film / (rows * dx);
@@ -305,8 +290,8 @@ class FractureFlow {
         throw CollectiveError("Error, fracture point " + std::to_string(gid_[i]) + " at (" +
                               std::to_string(r(i, kX)) + ", " + std::to_string(r(i, kX + 1)) +
                               ") has a non-finite aperture or pressure (aperture " +
-                              std::to_string(r(i, kAp)) + " m, p_f " + std::to_string(r(i, kPold)) +
-                              " Pa): the run has become unstable.");
+                              std::to_string(std::max(r(i, kOpen), 0.0)) + " m, p_f " +
+                              std::to_string(r(i, kPold)) + " Pa): the run has become unstable.");
       rhs_[i] =
           v * storage_[i] / dt * r(i, kPold) + v * gexch_[i] * r(i, kPhat) - v * opening_[i] / dt;
     }

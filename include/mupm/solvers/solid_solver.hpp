@@ -450,12 +450,8 @@ class SolidSolver : public Mechanics {
         [&] {
           disc_.dist.refresh({p.u, p.theta});
           solid_forces(disc_, prm_, law_, st_);
-          if (crack) {
-            undrained_fracture_pressure(disc_.bonds, p, pf_star_);
-            disc_.dist.refresh({as_vectors(pf_star_)});
-            crack_pressure_force(disc_.bonds, p, pf_star_, set_.fracture.crossing_measure,
-                                 st_.force);
-          }
+          if (crack)
+            add_crack_force(st_.force);
         },
         comm_, iterations);
     if (crack) {
@@ -511,11 +507,8 @@ class SolidSolver : public Mechanics {
     solid_forces(disc_, prm_, law_, st_);
     body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
     if (face_pressure()) {  // the crack's water on its faces (kernels/fracture_flow.hpp)
-      // p_f* at this displacement (undrained split, kernels/fracture_flow.hpp), onto the ghosts.
-      undrained_fracture_pressure(disc_.bonds, p, pf_star_);
-      disc_.dist.refresh({as_vectors(pf_star_)});
       Kokkos::deep_copy(crack_, 0.0);
-      crack_pressure_force(disc_.bonds, p, pf_star_, set_.fracture.crossing_measure, crack_);
+      add_crack_force(crack_);
       add_to_body(crack_);
     }
     forces_time_ = t;
@@ -554,6 +547,14 @@ class SolidSolver : public Mechanics {
     }
   }
   bool face_pressure() const { return set_.fracture.flow && set_.fracture.face_pressure; }
+  // Adds the crack water's force density to `out` (owned points): p_f* at this displacement
+  // (undrained split, kernels/fracture_flow.hpp), onto the ghosts, then its pair forces.
+  void add_crack_force(const Vectors& out) {
+    auto& p = disc_.points;
+    undrained_fracture_pressure(disc_.bonds, p, pf_star_);
+    disc_.dist.refresh({as_vectors(pf_star_)});
+    crack_pressure_force(disc_.bonds, p, pf_star_, set_.fracture.crossing_measure, out);
+  }
   void add_to_body(const Vectors& f) {
     auto b = body_;
     Kokkos::parallel_for(
