@@ -3,6 +3,7 @@
 #include "mupm/data/bonds.hpp"
 #include "mupm/data/points.hpp"
 #include "mupm/input/options.hpp"
+#include "mupm/kernels/j_integral.hpp"
 
 #include <unistd.h>
 #include <Teuchos_Array.hpp>
@@ -273,10 +274,13 @@ RCP<ParameterList> valid_parameters() {
           "its energy W (eq 34, accumulated from the force and moment states over the run) "
           "reaches W_cr = 4 G_cr/(pi delta^4) in 3D (eq 36), 3 G_cr/(2 h delta^3) in 2D "
           "(derivation in include/mupm/kernels/fracture.hpp); the energy it holds is booked "
-          "as fracture dissipation.",
+          "as fracture dissipation. J-Integral (2D, Algorithm 3): the first pre-crack advances "
+          "by J-Integral->Crack Increment along its direction, at most once a step, whenever J/h "
+          "of the first J-Integral contour >= G_cr: the bonds across the increment break.",
           bond_breaking_options().validator());
     f.set("Critical Energy Release Rate", 0.0,
-          "G_cr [J/m^2 = N/m] of the Energy criterion (> 0 with it).", at_least(0.0));
+          "G_cr [J/m^2 = N/m] of the Energy and J-Integral criteria (> 0 with them).",
+          at_least(0.0));
     f.set("Critical Damage", 0.3,
           "D_cr in (0, 1]: a point with damage D >= D_cr (eq 37) is a fracture point (eq 104; "
           "the paper gives no value). Points next to a pre-crack are fracture points from the "
@@ -310,6 +314,29 @@ RCP<ParameterList> valid_parameters() {
           "water. The crack water's stiffness K_w / a_min enters the solid's stable step: a "
           "small a_min (with a stiff water) means a small step.",
           positive());
+  }
+  {
+    ParameterList& j = pl->sublist(
+        "J-Integral", false,
+        "The micropolar J-integral (eqs 30, 125-126) around the tip of the first pre-crack, on "
+        "rectangular contours centred on the tip (2D). Time-series columns j_integral, "
+        "j_translational, j_rotational (first contour) and j_integral_<k> (contour k >= 2), per "
+        "unit thickness [J/m^2 = Pa m]. The tip: with Fracture->Bond Breakage = J-Integral the "
+        "pre-crack's End advanced by the crack's increments, otherwise the tracked tip "
+        "(crack_tip_x/y). Derivation and discretization in include/mupm/kernels/j_integral.hpp.");
+    j.set("Half Widths", Array<double>(),
+          "Half width along x of each contour (at most 8; empty: no J-integral), in Units. The "
+          "contour's edges are moved to the nearest cell faces.");
+    j.set("Half Heights", Array<double>(),
+          "Half height along y of each contour, in Units (empty: the Half Widths).");
+    j.set("Units", std::string("Spacings"),
+          "Units of Half Widths and Half Heights: Spacings (multiples of "
+          "Discretization->Spacing) or Metres.",
+          contour_units_options().validator());
+    j.set("Crack Increment", 0.0,
+          "Delta a [m] by which the J criterion (Fracture->Bond Breakage = J-Integral) advances "
+          "the crack each time J/h >= Critical Energy Release Rate (0: one Spacing).",
+          at_least(0.0));
   }
   {
     ParameterList& b =
@@ -529,6 +556,56 @@ Array<T> get_array(const ParameterList& l, const std::string& name, std::size_t 
   return a;
 }
 
+// J-Integral: 2D, a solid, a pre-crack, matching contour sizes that fit the body at the start.
+void check_j_integral(ParameterList& input, int dim, Physics phys) {
+  ParameterList& j = input.sublist("J-Integral");
+  const ParameterList& fr = input.sublist("Fracture");
+  const bool criterion =
+      bond_breaking_options()(fr.get<std::string>("Bond Breakage")) == BondBreaking::JIntegral;
+  const auto w = j.get<Array<double>>("Half Widths");
+  auto h = j.get<Array<double>>("Half Heights");
+  if (w.empty() && !h.empty())
+    throw InputError("Error, " + path_of(j, "Half Heights") + " is given without " +
+                     path_of(j, "Half Widths") + ".");
+  if (w.empty()) {
+    if (criterion)
+      throw InputError("Error, " + path_of(fr, "Bond Breakage") + " = J-Integral needs " +
+                       path_of(j, "Half Widths") + ": at least one contour around the tip.");
+    return;
+  }
+  const std::string what = path_of(j, "Half Widths");
+  if (dim != 2)
+    throw InputError("Error, " + what + ": the J-integral is 2D (Discretization->Dimension = 2).");
+  if (!has_solid(phys))
+    throw InputError("Error, " + what +
+                     ": the J-integral needs Solver->Physics = Micropolar Solid or "
+                     "Hydro-Mechanical.");
+  const ParameterList& d = input.sublist("Discretization");
+  if (d.sublist("Pre-Cracks").numParams() == 0)
+    throw InputError("Error, " + what +
+                     ": the J-integral's contours surround the tip of the first "
+                     "Discretization->Pre-Cracks entry; there is none.");
+  if (w.size() > kMaxContours)
+    throw InputError("Error, " + what + " lists " + std::to_string(w.size()) +
+                     " contours; at most " + std::to_string(kMaxContours) + " are supported.");
+  if (!h.empty() && h.size() != w.size())
+    throw InputError("Error, " + path_of(j, "Half Heights") + " has " + std::to_string(h.size()) +
+                     " values and " + what + " " + std::to_string(w.size()) +
+                     ": give one per contour, or none.");
+  if (h.empty())
+    h = w;
+  const double dx = d.get<double>("Spacing");
+  const double unit =
+      contour_units_options()(j.get<std::string>("Units")) == ContourUnits::Metres ? 1.0 : dx;
+  for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
+    for (double v : {w[k], h[k]})
+      if (!(v * unit >= dx))
+        throw InputError("Error, " + what + " / Half Heights: contour " + std::to_string(k + 1) +
+                         " has a half size of " + std::to_string(v * unit) +
+                         " m, below one Spacing (" + std::to_string(dx) +
+                         " m): a contour must hold the tip and the points around it.");
+}
+
 void check_region(const ParameterList& c, const ParameterList& regions,
                   const Array<std::string>& faces);
 
@@ -726,6 +803,7 @@ void check_dimension_arrays(ParameterList& input) {
                        " must be > 0 for " + path_of(fr, "Bond Breakage") + " = " +
                        fr.get<std::string>("Bond Breakage") + ".");
   }
+  check_j_integral(input, dim, phys);
 }
 
 void check_region(const ParameterList& c, const ParameterList& regions,
@@ -898,8 +976,8 @@ MemoryNeed memory_need_of(const ParameterList& input, int ranks) {
   // plus the sort keys of the neighbour build.
   const double per_point = double(Points<Dim>::bytes_per_point()) + (Dim == 2 ? 512 : 1024);
   const bool breaks =
-      bond_breaking_options()(input.sublist("Fracture").get<std::string>("Bond Breakage")) !=
-      BondBreaking::None;
+      bond_breaking_options()(input.sublist("Fracture").get<std::string>("Bond Breakage")) ==
+      BondBreaking::Energy;
   const double per_bond =
       double(Bonds::bytes_per_bond(breaks ? Dim + kRotDim<Dim> : 0)) + sizeof(GlobalId);
   m.bytes_per_rank = (n + ghosts) * per_point + n * m.bonds_per_point * per_bond;

@@ -39,9 +39,15 @@ const Options<RetentionModel>& retention_model_options() {
       {{"Saturated", RetentionModel::Saturated}, {"Van Genuchten", RetentionModel::VanGenuchten}});
   return o;
 }
+const Options<ContourUnits>& contour_units_options() {
+  static const Options<ContourUnits> o(
+      "Units", {{"Spacings", ContourUnits::Spacings}, {"Metres", ContourUnits::Metres}});
+  return o;
+}
 const Options<BondBreaking>& bond_breaking_options() {
-  static const Options<BondBreaking> o(
-      "Bond Breakage", {{"None", BondBreaking::None}, {"Energy", BondBreaking::Energy}});
+  static const Options<BondBreaking> o("Bond Breakage", {{"None", BondBreaking::None},
+                                                         {"Energy", BondBreaking::Energy},
+                                                         {"J-Integral", BondBreaking::JIntegral}});
   return o;
 }
 const Options<CrackWaterForce>& crack_water_force_options() {
@@ -167,6 +173,21 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.fracture.face_pressure =
       crack_water_force_options()(fracture.get<std::string>("Crack Water Force")) ==
       CrackWaterForce::FacePressure;
+
+  const ParameterList& j = input.sublist("J-Integral");
+  const auto widths = j.get<Teuchos::Array<double>>("Half Widths");
+  auto heights = j.get<Teuchos::Array<double>>("Half Heights");
+  if (heights.empty())
+    heights = widths;
+  const double unit = contour_units_options()(j.get<std::string>("Units")) == ContourUnits::Metres
+                          ? 1.0
+                          : m.grid.dx;
+  for (Teuchos::Ordinal k = 0; k < widths.size() && k < heights.size(); ++k)
+    m.j_integral.half.push_back({widths[k] * unit, heights[k] * unit});
+  m.j_integral.criterion = m.fracture.criterion == BondBreaking::JIntegral;
+  m.j_integral.critical = fracture.get<double>("Critical Energy Release Rate");
+  const double inc = j.get<double>("Crack Increment");
+  m.j_integral.increment = inc > 0 ? inc : m.grid.dx;
 
   m.boundary_conditions = boundary_conditions_from_input(input);
   m.initial_conditions = initial_conditions_from_input(input);

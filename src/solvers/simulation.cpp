@@ -21,6 +21,7 @@
 #include "mupm/io/csv.hpp"
 #include "mupm/io/field_output.hpp"
 #include "mupm/io/point_rows.hpp"
+#include "mupm/solvers/j_integral.hpp"
 #include "mupm/solvers/kinematics.hpp"
 #include "mupm/solvers/solid_solver.hpp"
 #include "mupm/solvers/step_sequence.hpp"
@@ -168,6 +169,7 @@ struct Assembly {
   std::unique_ptr<FluidSolver<Dim>> fluid;
   std::unique_ptr<Mechanics> mechanics;  // the micropolar solid, kinematics, or none
   std::unique_ptr<Damage<Dim>> damage;
+  std::unique_ptr<JIntegral<Dim>> j_integral;  // J-Integral->Half Widths given
   StepSequence<Dim> sequence;
   double spacing = 0;  // dx, for messages
   // The stable-step watch's state (StableStepWatch), kept across a restart so that a restarted
@@ -184,6 +186,8 @@ struct Assembly {
       m.push_back(mechanics.get());
     if (fluid)
       m.push_back(fluid.get());
+    if (j_integral)
+      m.push_back(j_integral.get());
     return m;
   }
   // Module set-up in the order the coupling needs: the fluid (S_r, C, flow of the state), then
@@ -219,6 +223,9 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   if (has_fluid(physics))
     ph.fluid =
         std::make_unique<FluidSolver<Dim>>(disc, model.fluid, model.boundary_conditions, mpi);
+  ph.damage = std::make_unique<Damage<Dim>>(disc, model.fracture.critical_damage, mpi);
+  if (!model.j_integral.half.empty())
+    ph.j_integral = std::make_unique<JIntegral<Dim>>(disc, model.j_integral, *ph.damage, mpi);
   if (has_solid(physics)) {
     typename SolidSolver<Dim>::Settings settings;
     settings.rho_s = model.solid_density;
@@ -227,17 +234,24 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
     settings.damping = model.damping;
     settings.fracture = model.fracture;
     switch (model.constitutive_model) {
-      case ConstitutiveModel::MicropolarElastic:
-        ph.mechanics = std::make_unique<SolidSolver<Dim, MicropolarElastic>>(
+      case ConstitutiveModel::MicropolarElastic: {
+        auto solid = std::make_unique<SolidSolver<Dim, MicropolarElastic>>(
             disc, model.solid, model.boundary_conditions, settings, mpi);
+        if (auto* j = ph.j_integral.get()) {
+          j->attach(solid->state(), solid->params());
+          solid->keep_pore_part();
+          if (model.j_integral.criterion)
+            solid->set_crack_driver([j] { return j->advance(); });
+        }
+        ph.mechanics = std::move(solid);
         break;
+      }
     }
   } else if (physics == Physics::KinematicsOnly) {
     ph.mechanics = std::make_unique<Kinematics<Dim>>(disc);
   }
   if (ph.fluid && model.fracture.flow)
     ph.fluid->enable_fracture_flow(model.fracture);
-  ph.damage = std::make_unique<Damage<Dim>>(disc, model.fracture.critical_damage, mpi);
   ph.spacing = disc.grid.dx;
   ph.sequence.mechanics = ph.mechanics.get();
   ph.sequence.fluid = ph.fluid.get();
@@ -673,7 +687,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
 
   Discretization<Dim> disc = discretize(comm, model.grid);
   Points<Dim>& pts = disc.points;
-  const int pair_width = model.fracture.criterion != BondBreaking::None ? Dim + kRotDim<Dim> : 0;
+  const int pair_width = model.fracture.criterion == BondBreaking::Energy ? Dim + kRotDim<Dim> : 0;
   const long long n_bonds = report_discretization(disc, *comm, pair_width, out);
   const long long n_global = disc.dist.n_global();
   check_regions(model, disc, mpi);

@@ -224,6 +224,18 @@ head -n 1 help.out | grep -q "^usage: mupm" || { cat help.out; fail "--help: std
 env -u OMP_PROC_BIND "$MUPM" --validate valid.xml >validate.out
 [[ $(wc -l <validate.out) == 1 ]] && grep -q "^mupm: valid.xml is valid; it needs about .* MiB per rank" validate.out ||
   { cat validate.out; fail "--validate: stdout is not the verdict alone"; }
+# J-Integral: contours without a pre-crack, the J criterion without contours, mismatched sizes.
+jlist() {  # jlist J-INTEGRAL-PARAMETERS: a list placed before Solver
+  sed "s|  <ParameterList name=\"Solver\">|  <ParameterList name=\"J-Integral\">$1</ParameterList>\n&|"
+}
+crack='<ParameterList name="Pre-Cracks"><ParameterList name="c"><Parameter name="Start" type="Array(double)" value="{-0.01, 0.05}"/><Parameter name="End" type="Array(double)" value="{0.1, 0.05}"/></ParameterList></ParameterList>'
+base '' '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/>' >j_no_crack.xml
+expect j_no_crack 2 'mupm->J-Integral->Half Widths' 'Pre-Cracks'
+base "$crack" '' | jlist '' |
+  sed 's|  <ParameterList name="Solver">|  <ParameterList name="Fracture"><Parameter name="Bond Breakage" type="string" value="J-Integral"/><Parameter name="Critical Energy Release Rate" type="double" value="10"/></ParameterList>\n&|' >j_no_contour.xml
+expect j_no_contour 2 'mupm->Fracture->Bond Breakage' 'mupm->J-Integral->Half Widths'
+base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3, 4}"/><Parameter name="Half Heights" type="Array(double)" value="{3}"/>' >j_sizes.xml
+expect j_sizes 2 'mupm->J-Integral->Half Heights' 'one per contour'
 # A grid beyond the machine's memory is refused before anything is allocated, by the run and by
 # --validate (it once grew until the kernel killed it, or ended in std::bad_alloc).
 base '' '' | sed 's|value="{20, 10}"|value="{20000, 20000}"|' >huge.xml

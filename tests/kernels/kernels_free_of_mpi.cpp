@@ -5,6 +5,8 @@
 #include "mupm/kernels/damage.hpp"
 #include "mupm/kernels/fluid.hpp"
 #include "mupm/kernels/fracture.hpp"
+#include "mupm/kernels/fracture_flow.hpp"
+#include "mupm/kernels/j_integral.hpp"
 #include "mupm/kernels/shape_tensor.hpp"
 #include "mupm/kernels/solid.hpp"
 #include "mupm/laws/micropolar_elastic.hpp"

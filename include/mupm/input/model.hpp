@@ -12,6 +12,7 @@
 #include "mupm/input/input.hpp"
 #include "mupm/input/options.hpp"
 #include "mupm/kernels/fluid.hpp"
+#include "mupm/kernels/j_integral.hpp"
 #include "mupm/kernels/solid.hpp"
 #include "mupm/mesh/grid.hpp"
 
@@ -76,6 +77,7 @@ struct Model {
   double damping = 0;           // Solver->Damping
   FluidParams fluid;
   FractureParams fracture;
+  JIntegralParams j_integral;          // no contours: no J
   double porosity = 0;                 // Materials->Porosity (initial)
   Kokkos::Array<double, 3> gravity{};  // Solver->Gravity
   std::vector<BoundaryCondition> boundary_conditions;

@@ -34,6 +34,8 @@ enum class RetentionModel { Saturated, VanGenuchten };
 enum class BondEnergyState { Effective, Total };
 // Fracture->Crack Water Force.
 enum class CrackWaterForce { FacePressure, Eq17 };
+// J-Integral->Units.
+enum class ContourUnits { Spacings, Metres };
 
 template <class E>
 class Options {
@@ -80,6 +82,7 @@ const Options<RetentionModel>& retention_model_options();
 const Options<BondBreaking>& bond_breaking_options();
 const Options<BondEnergyState>& bond_energy_state_options();
 const Options<CrackWaterForce>& crack_water_force_options();
+const Options<ContourUnits>& contour_units_options();
 const Options<BoundaryCondition::Kind>& boundary_condition_options();
 const Options<TimeFunction::Kind>& time_function_options();
 // Boundary Conditions->NAME->Component: the axis (x, y, z) as 0, 1, 2.

@@ -25,12 +25,15 @@
 
 #include <cmath>
 
+#include "mupm/core/geometry.hpp"
 #include "mupm/data/bonds.hpp"
 #include "mupm/data/points.hpp"
 
 namespace mupm {
 
-enum class BondBreaking { None, Energy };
+// None: bonds never break; Energy: eqs 34-36 (below); JIntegral: the J criterion (Algorithm 3,
+// include/mupm/solvers/j_integral.hpp).
+enum class BondBreaking { None, Energy, JIntegral };
 
 struct FractureParams {
   BondBreaking criterion = BondBreaking::None;
@@ -95,6 +98,37 @@ Breakage break_bonds(const Points<Dim>& pts, const Bonds& bonds, double w_cr,
       },
       out.bonds, out.energy);
   return out;
+}
+
+// Breaks the intact bonds of the owned points that cross `seg` (reference positions: both
+// copies of a bond break, whichever ranks own its ends). Returns the directed bonds broken.
+template <int Dim>
+long long break_crossing(const Points<Dim>& pts, const Bonds& bonds, const Crack& seg) {
+  auto offsets = bonds.offsets;
+  auto neighbor = bonds.neighbor;
+  auto intact = bonds.intact;
+  auto x = pts.x;
+  long long n = 0;
+  Kokkos::parallel_reduce(
+      "mupm::Fracture::break_crossing", range(0, pts.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i, long long& acc) {
+        double xi[Dim], xj[Dim];
+        for (int d = 0; d < Dim; ++d)
+          xi[d] = x(i, d);
+        for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
+          if (!intact(b))
+            continue;
+          const int j = neighbor(b);
+          for (int d = 0; d < Dim; ++d)
+            xj[d] = x(j, d);
+          if (bond_crosses<Dim>(seg, xi, xj)) {
+            intact(b) = 0;
+            ++acc;
+          }
+        }
+      },
+      n);
+  return n;
 }
 
 }  // namespace mupm

@@ -10,6 +10,7 @@
 #include <mpi.h>
 
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -91,17 +92,29 @@ class SolidSolver : public Mechanics {
     if (set_.fracture.flow && !set_.fracture.face_pressure)  // eq 17 (kernels/solid.hpp)
       st_.allocate_eq17(p.size(), p.n_owned);
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
-    du_ = Vectors("mupm::step_increment", breaks() ? p.size() : p.n_owned, Dim + R);
+    du_ = Vectors("mupm::step_increment", energy_criterion() ? p.size() : p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
     if (breaks()) {
-      disc_.bonds.hold_pair_forces(Dim + R);
       f_old_ = Vectors("mupm::force_before_breakage", p.n_owned, Dim);
       l_old_ = Vectors("mupm::moment_before_breakage", p.n_owned, R);
+    }
+    if (energy_criterion()) {
+      disc_.bonds.hold_pair_forces(Dim + R);
       st_.increment = du_;
       st_.max_energy = Scalars("mupm::max_bond_energy", p.n_owned);
     }
   }
+  // Bonds break during the run (by either criterion); the bond energies are accumulated for the
+  // energy criterion only.
   bool breaks() const { return set_.fracture.criterion != BondBreaking::None; }
+  bool energy_criterion() const { return set_.fracture.criterion == BondBreaking::Energy; }
+  // What breaks bonds besides the energy criterion (the J criterion, include/mupm/solvers/
+  // j_integral.hpp): called after the step's forces, before the velocity update; collective;
+  // returns the directed bonds it broke on this rank.
+  void set_crack_driver(std::function<Breakage()> driver) { driver_ = std::move(driver); }
+  // The pore-water part of the force state kept apart (SolidState::P1w) for the J-integral's
+  // effective force state too, without breakage (before initialize).
+  void keep_pore_part() { keep_pore_part_ = true; }
 
   const SolidState<Dim>& state() const { return st_; }
   const SolidParams& params() const { return prm_; }
@@ -178,7 +191,7 @@ class SolidSolver : public Mechanics {
     // Pore water pressure, for the whole run: a fluid (undrained modulus set from the start), or
     // a held initial pressure (without a fluid p never changes). The effective force state's
     // bond energy then needs the pore-water part of P1 apart.
-    pressure_ = breaks() && has_pressure();
+    pressure_ = (breaks() || keep_pore_part_) && has_pressure();
     if (pressure_ && set_.fracture.effective_state && st_.P1w.extent(0) == 0)
       st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
     if (!restarted)
@@ -188,7 +201,7 @@ class SolidSolver : public Mechanics {
     // the checkpoint's: they are the states the forces had when applied, with the pore pressure
     // of before the step's fluid update (Solid First), which the forces evaluated here no
     // longer have.
-    st_.work = breaks() && !restarted ? BondWork::Record : BondWork::Off;
+    st_.work = energy_criterion() && !restarted ? BondWork::Record : BondWork::Off;
     forces(t);
     // Points::solid_pressure is the p* of the forces last applied (the pore work of the next
     // step starts from it); a restart has it from the checkpoint, not from the pressure the
@@ -217,19 +230,22 @@ class SolidSolver : public Mechanics {
     double w[6] = {0.5 * power(), 0, 0, 0, 0, 0};
     Kokkos::deep_copy(vs_old_,
                       Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
-    st_.work = breaks() ? BondWork::Accumulate : BondWork::Off;
+    st_.work = energy_criterion() ? BondWork::Accumulate : BondWork::Off;
     forces(t + dt);
     w[0] += 0.5 * power();  // new forces (second half)
     w[1] = dt * damping_power();
     w[2] = pore_power() + eq17_power();
     keep_applied();
-    if (breaks()) {
+    if (breaks())
+      w[5] = stored_energy();
+    if (energy_criterion()) {
       const Breakage br = break_bonds(p, disc_.bonds, set_.fracture.critical_energy, st_.max_energy,
                                       p.bond_energy_released);
       w[3] = double(br.bonds);
       w[4] = br.energy;
-      w[5] = stored_energy();
     }
+    if (driver_)
+      w[3] += double(driver_().bonds);
     MPI_Allreduce(MPI_IN_PLACE, w, 6, MPI_DOUBLE, MPI_SUM, comm_);
     work_ += w[0];
     dissipation_ += w[1];
@@ -266,7 +282,7 @@ class SolidSolver : public Mechanics {
     const auto owned = std::make_pair(std::size_t(0), p.n_owned);
     Kokkos::deep_copy(vs_old_, Kokkos::subview(p.vol_strain, owned));
     disc_.update_shape();
-    st_.work = BondWork::Record;
+    st_.work = energy_criterion() ? BondWork::Record : BondWork::Off;
     forces(t);
     if (pressure_) {
       auto ref = p.vol_strain_ref, vs = p.vol_strain;
@@ -691,10 +707,12 @@ class SolidSolver : public Mechanics {
   Vectors f_old_, l_old_;   // forces of the old bond set at a breakage
   Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
-  double fracture_energy_ = 0;       // strain energy lost to bond breakage since t = 0 [J]
-  double bond_energy_released_ = 0;  // W V_i V_j of the bonds broken since t = 0 [J]
-  double broken_pairs_ = 0;          // bond pairs broken since t = 0 (a restart global)
-  bool pressure_ = false;            // breakage run with pore pressure (initialize)
+  double fracture_energy_ = 0;        // strain energy lost to bond breakage since t = 0 [J]
+  double bond_energy_released_ = 0;   // W V_i V_j of the bonds broken since t = 0 [J]
+  double broken_pairs_ = 0;           // bond pairs broken since t = 0 (a restart global)
+  bool pressure_ = false;             // breakage run with pore pressure (initialize)
+  bool keep_pore_part_ = false;       // P1w for the J-integral (keep_pore_part)
+  std::function<Breakage()> driver_;  // the J criterion (set_crack_driver)
 };
 
 }  // namespace mupm

@@ -1,0 +1,174 @@
+// The micropolar J-integral on rectangular contours around a crack tip (paper eqs 30, 125, 126;
+// FORMULATION "J-integral"). 2D (plane strain, thickness h). Kernels only: the per-point terms;
+// the solver sums them over the ranks in a fixed order (include/mupm/solvers/j_integral.hpp).
+//
+// Derivation (the paper's eq 30 carries its cross term with one xi for two bonds; this is the
+// reading that follows from the model's own energy, FORMULATION "Pass 2"). A point's energy rate
+// is dW_i/dt = sum_j [T_ij.(du_j - du_i - (dth_i + dth_j)/2 x xi_ij) + M_ij.(dth_j - dth_i)] V_j.
+// Summed over a region B1, the pairs inside cancel against B1's share of the force and moment
+// balances (f_i = 0, l_i = 0 in equilibrium), and what is left is the power that crosses the
+// contour through the bonds i in B1, j outside (B2):
+//   P = sum_{i in B1, j in B2} V_i V_j [ T_ij.du_j - T_ji.du_i + M_ij.dth_j - M_ji.dth_i
+//                                        - 1/2 ((xi_ij x T_ij).dth_j + (xi_ij x T_ji).dth_i) ].
+// For a crack tip moving steadily along the crack direction d (x_1), du = -v du/dx_1 and the
+// region's energy flux is v int W n_1 dA, so the energy released per unit crack advance is
+//   J = int_{dB1} W n.d dA - sum_{i in B1, j in B2} V_i V_j [ T_ij.u_1(j) - T_ji.u_1(i)
+//       + M_ij th_1(j) - M_ji th_1(i) - 1/2 ((xi x T_ij) th_1(j) + (xi x T_ji) th_1(i)) ],
+// with u_1 = (grad u) d, th_1 = kappa d the derivatives along d from the nonlocal gradients:
+// grad u = eps + the rotation eps subtracts (2D: eps_xy = du_x/dy + theta, eps_yx = du_y/dx -
+// theta, FORMULATION "Pass 1", so du_x/dy = eps_xy - theta, du_y/dx = eps_yx + theta). For an
+// affine field the bond sum is t.u_1 integrated over the contour (t = sigma n: sum_{B1,B2} (T_ij -
+// T_ji) V_i V_j is the force B2 exerts on B1), so this is the continuum micropolar J, int (W n_1 -
+// t.u_1 - m th_1) dA. J per unit thickness (the paper's Pa m, G = J/h of eq 126) divides by h.
+//
+// The parts (the paper's Tables 1 and 3): translational = the W term and the u terms; micro-
+// rotational = the theta terms (the M terms and the 1/2 xi x T terms). The paper's tables add up
+// to J this way (20.3 + 0.18 = 20.48, 6.49 + 4.02 = 10.51).
+//
+// The discrete contour. Each contour is an axis-aligned rectangle whose edges lie on cell faces
+// (between lattice lines): B1 is the points inside, B2 those outside. The W term of an edge is
+// int W n.d ds with W at the edge the mean of the two points that straddle it (the row or column
+// just inside and just outside, each at dx/2 from it): each of them adds W_i dx (n.d)/2 for the
+// part of the edge its row spans. W is the point's energy density with the stabilization
+// energy (solid pass 1, SolidState::energy / V). Bonds across the crack are broken and carry no
+// power; an edge that crosses the crack is cut by it.
+//
+// Force state: the one the bond energy uses (Fracture->Bond Energy Force State): with pore water
+// and Effective (default), the skeleton's, T-bar = T + S_r p* K^-1 xi (the paper's eqs 23, 30:
+// the effective force state). Without pore pressure both are the same.
+#ifndef MUPM_J_INTEGRAL_HPP
+#define MUPM_J_INTEGRAL_HPP
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "mupm/core/geometry.hpp"
+#include "mupm/kernels/solid.hpp"
+
+namespace mupm {
+
+constexpr int kMaxContours = 8;
+
+// The J-Integral input (include/mupm/solvers/j_integral.hpp).
+struct JIntegralParams {
+  std::vector<std::array<double, 2>> half;  // half width (x) and half height (y) per contour [m]
+  bool criterion = false;                   // Fracture->Bond Breakage = J-Integral
+  double critical = 0;                      // G_cr [J/m^2]
+  double increment = 0;                     // Delta a [m]
+};
+
+// Contours (faces on cell faces), the crack direction d (unit), and the thickness h.
+struct JContours {
+  int count = 0;
+  Kokkos::Array<Box, kMaxContours> box;
+  double d[2] = {1, 0};
+  double thickness = 1;
+  double dx = 0;
+};
+
+// Per owned point i and contour c: out(i, 3c + 0) the W term, 3c + 1 the u terms, 3c + 2 the
+// theta terms (each already signed as it enters J, per unit thickness). u, theta, eps, kappa,
+// P1, P2, w0 (and P1w when allocated) current on the ghosts, as solid pass 2 leaves them.
+inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const SolidParams& prm,
+                             const SolidState<2>& st, const JContours& jc, const Vectors& out) {
+  constexpr int Dim = 2, R = 1;
+  auto offsets = bonds.offsets;
+  auto neighbor = bonds.neighbor;
+  auto intact = bonds.intact;
+  auto x = pts.x, u = pts.u, th = pts.theta;
+  auto vol = pts.volume;
+  auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, P1w = st.P1w;
+  auto w0 = st.w0, energy = st.energy;
+  const bool effective = P1w.extent(0) > 0;
+  const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
+  const double c2 = prm.stabilization * prm.stab_modulus;
+  const JContours c = jc;
+  Kokkos::parallel_for(
+      "mupm::JIntegral::terms", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        const double xi_[2] = {x(i, 0), x(i, 1)};
+        // u_1 = (grad u) d and th_1 = kappa d of a point (header).
+        auto derivs = [&](int k, double* g, double& h) {
+          const double t = th(k, 0);
+          const double G[4] = {eps(k, 0), eps(k, 1) - t, eps(k, 2) + t, eps(k, 3)};
+          g[0] = G[0] * c.d[0] + G[1] * c.d[1];
+          g[1] = G[2] * c.d[0] + G[3] * c.d[1];
+          h = kap(k, 0) * c.d[0] + kap(k, 1) * c.d[1];
+        };
+        double gi[2], hi;
+        derivs(int(i), gi, hi);
+        const double Wi = energy(i) / vol(i);
+        for (int ci = 0; ci < c.count; ++ci) {
+          const Box& b = c.box[ci];
+          double w = 0, tr = 0, rot = 0;
+          // W term: the points at dx/2 from an edge, within the edge's span.
+          for (int a = 0; a < Dim; ++a) {
+            const int o = 1 - a;  // the edge runs along axis o
+            if (!(xi_[o] > b.lo[o] && xi_[o] < b.hi[o]))
+              continue;
+            if (std::abs(xi_[a] - b.hi[a]) < c.dx)
+              w += 0.5 * Wi * c.dx * c.d[a];  // edge x_a = hi: n = +e_a
+            if (std::abs(xi_[a] - b.lo[a]) < c.dx)
+              w -= 0.5 * Wi * c.dx * c.d[a];  // edge x_a = lo: n = -e_a
+          }
+          // Bond terms: i in B1 (inside), j in B2 (outside).
+          if (in_box<Dim>(b, xi_, 0.0)) {
+            for (BondIndex bd = offsets(i); bd < offsets(i + 1); ++bd) {
+              if (!intact(bd))
+                continue;
+              const int j = neighbor(bd);
+              const double xj_[2] = {x(j, 0), x(j, 1)};
+              if (in_box<Dim>(b, xj_, 0.0))
+                continue;
+              double xi[Dim], Uh[Dim], Om[R];
+              const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, Uh, Om);
+              const double len = std::sqrt(len2);
+              const double a1 = c1 / (len2 * len), a2 = c2 / len;
+              const double a1i = w0(i) > 0 ? a1 / w0(i) : 0.0, a2i = w0(i) > 0 ? a2 / w0(i) : 0.0;
+              const double a1j = w0(j) > 0 ? a1 / w0(j) : 0.0, a2j = w0(j) > 0 ? a2 / w0(j) : 0.0;
+              // T_ij = P1_i xi + a1i (U^ - eps_i xi); T_ji = -(P1_j xi + a1j (U^ - eps_j xi)).
+              double Tij[Dim], Tji[Dim];
+              for (int d = 0; d < Dim; ++d) {
+                double pi = 0, pj = 0, ei = 0, ej = 0, wi = 0, wj = 0;
+                for (int k = 0; k < Dim; ++k) {
+                  pi += P1(i, d * Dim + k) * xi[k];
+                  pj += P1(j, d * Dim + k) * xi[k];
+                  ei += eps(i, d * Dim + k) * xi[k];
+                  ej += eps(j, d * Dim + k) * xi[k];
+                  if (effective) {
+                    wi += P1w(i, d * Dim + k) * xi[k];
+                    wj += P1w(j, d * Dim + k) * xi[k];
+                  }
+                }
+                Tij[d] = pi + a1i * (Uh[d] - ei) + wi;
+                Tji[d] = -(pj + a1j * (Uh[d] - ej)) - wj;
+              }
+              // M_ij = P2_i xi + a2i (Omega - kappa_i xi); M_ji = -(P2_j xi + a2j (...)).
+              double pi = 0, pj = 0, ki = 0, kj = 0;
+              for (int k = 0; k < Dim; ++k) {
+                pi += P2(i, k) * xi[k];
+                pj += P2(j, k) * xi[k];
+                ki += kap(i, k) * xi[k];
+                kj += kap(j, k) * xi[k];
+              }
+              const double Mij = pi + a2i * (Om[0] - ki);
+              const double Mji = -(pj + a2j * (Om[0] - kj));
+              double gj[2], hj;
+              derivs(j, gj, hj);
+              const double vv = vol(i) * vol(j) / c.thickness;
+              const double xTij = xi[0] * Tij[1] - xi[1] * Tij[0];
+              const double xTji = xi[0] * Tji[1] - xi[1] * Tji[0];
+              tr -= (Tij[0] * gj[0] + Tij[1] * gj[1] - Tji[0] * gi[0] - Tji[1] * gi[1]) * vv;
+              rot -= (Mij * hj - Mji * hi - 0.5 * (xTij * hj + xTji * hi)) * vv;
+            }
+          }
+          out(i, 3 * ci + 0) = w;
+          out(i, 3 * ci + 1) = tr;
+          out(i, 3 * ci + 2) = rot;
+        }
+      });
+}
+
+}  // namespace mupm
+
+#endif

@@ -1,0 +1,192 @@
+// The J-integral module (paper eqs 125-126, Algorithm 3; kernel and derivation in
+// include/mupm/kernels/j_integral.hpp): J on rectangular contours around the tip of the first
+// pre-crack, its time-series columns, and the J criterion.
+//
+// The tip. With the J criterion (Fracture->Bond Breakage = J-Integral) the crack is the
+// pre-crack's segment Start -> End grown by n increments Delta a along its direction d (n is
+// kept across a restart); the tip is End + n Delta a d. Otherwise the tip is the tracked one of
+// the damage module (crack_tip_x/y: the farthest fracture point along d, or End before growth).
+// Each contour is centred on the tip with the given half width (along x) and half height, its
+// edges moved to the nearest cell faces; the contours move with the tip.
+//
+// The J criterion (Algorithm 3): after the solid's step (its forces of the new state), while
+// J/h of the first contour >= G_cr the crack advances one increment: the intact bonds that
+// cross the segment tip -> tip + Delta a d break (both copies: the test is on reference
+// positions, the same on every rank), at most one increment a step (the next step's J sees the
+// new tip and the new bond set).
+//
+// Sums over ranks: every point's terms are gathered with its global id and added in id order,
+// so that J, and with it the criterion's decision, is the same to the last bit on any number of
+// ranks and threads.
+#ifndef MUPM_SOLVERS_J_INTEGRAL_HPP
+#define MUPM_SOLVERS_J_INTEGRAL_HPP
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mupm/kernels/fracture.hpp"
+#include "mupm/kernels/j_integral.hpp"
+#include "mupm/solvers/damage.hpp"
+
+namespace mupm {
+
+template <int Dim>
+class JIntegral : public Module {
+ public:
+  struct Value {
+    double total = 0, translational = 0, rotational = 0;  // per unit thickness [J/m^2]
+  };
+
+  JIntegral(Discretization<Dim>& disc, const JIntegralParams& prm, const Damage<Dim>& damage,
+            MPI_Comm comm)
+      : disc_(disc), prm_(prm), damage_(damage), comm_(comm) {
+    static_assert(Dim == 2 || Dim == 3);
+    terms_ = Vectors("mupm::j_integral_terms", disc.points.n_owned, 3 * prm.half.size());
+    const Crack& c = disc.grid.cracks.front();
+    double len = 0;
+    for (int k = 0; k < 2; ++k) {
+      d_[k] = c.b[k] - c.a[k];
+      len += d_[k] * d_[k];
+    }
+    for (int k = 0; k < 2; ++k)
+      d_[k] /= std::sqrt(len);
+  }
+  // The solid's state and constants whose force states J integrates.
+  void attach(const SolidState<Dim>& st, const SolidParams& sp) {
+    st_ = &st;
+    sp_ = sp;
+  }
+
+  const char* name() const override { return "j_integral"; }
+  void globals(GlobalRefs& g) override {
+    if (prm_.criterion)
+      g("advances", advances_);
+  }
+  // j_integral, j_translational, j_rotational of the first contour; j_integral_<k> of contour k.
+  void series(SeriesRow& row) const override {
+    const auto v = evaluate();
+    row("j_integral", v[0].total);
+    row("j_translational", v[0].translational);
+    row("j_rotational", v[0].rotational);
+    for (std::size_t k = 1; k < v.size(); ++k)
+      row("j_integral_" + std::to_string(k + 1), v[k].total);
+  }
+
+  // The tip now (header). Collective.
+  std::array<double, 2> tip() const {
+    const Crack& c = disc_.grid.cracks.front();
+    if (prm_.criterion)
+      return {c.b[0] + advances_ * prm_.increment * d_[0],
+              c.b[1] + advances_ * prm_.increment * d_[1]};
+    const auto t = damage_.crack_tip();
+    return {t.x[0], t.x[1]};
+  }
+
+  // The contours around `tip`, edges on the nearest cell faces.
+  JContours contours(const std::array<double, 2>& tip) const {
+    const auto& g = disc_.grid;
+    JContours jc;
+    jc.count = int(prm_.half.size());
+    jc.d[0] = d_[0];
+    jc.d[1] = d_[1];
+    jc.thickness = g.thickness;
+    jc.dx = g.dx;
+    auto face = [&](int k, double v) {
+      return g.origin[k] + std::round((v - g.origin[k]) / g.dx) * g.dx;
+    };
+    for (int c = 0; c < jc.count; ++c)
+      for (int k = 0; k < 2; ++k) {
+        jc.box[c].lo[k] = face(k, tip[k] - prm_.half[c][k]);
+        jc.box[c].hi[k] = face(k, tip[k] + prm_.half[c][k]);
+      }
+    return jc;
+  }
+
+  // J of every contour at the current tip (collective; the same bits on every rank).
+  std::vector<Value> evaluate() const { return evaluate(contours(tip())); }
+  std::vector<Value> evaluate(const JContours& jc) const {
+    const int nc = jc.count;
+    std::vector<Value> out(static_cast<std::size_t>(nc));
+    if constexpr (Dim == 2) {
+      const auto& p = disc_.points;
+      j_integral_terms(p, disc_.bonds, sp_, *st_, jc, terms_);
+      auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), terms_);
+      auto gid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.gid);
+      // Rows of the points with a term: global id, then 3 nc terms.
+      const int w = 1 + 3 * nc;
+      std::vector<double> mine;
+      for (std::size_t i = 0; i < p.n_owned; ++i) {
+        bool any = false;
+        for (int k = 0; k < 3 * nc; ++k)
+          any = any || h(i, k) != 0;
+        if (!any)
+          continue;
+        mine.push_back(double(gid(i)));
+        for (int k = 0; k < 3 * nc; ++k)
+          mine.push_back(h(i, k));
+      }
+      int size = 0, n = int(mine.size());
+      MPI_Comm_size(comm_, &size);
+      std::vector<int> counts(static_cast<std::size_t>(size)), displs(counts.size(), 0);
+      MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+      for (int r = 1; r < size; ++r)
+        displs[std::size_t(r)] = displs[std::size_t(r - 1)] + counts[std::size_t(r - 1)];
+      std::vector<double> all(std::size_t(displs.back() + counts.back()));
+      MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+                     MPI_DOUBLE, comm_);
+      std::vector<std::size_t> rows(all.size() / std::size_t(w));
+      for (std::size_t r = 0; r < rows.size(); ++r)
+        rows[r] = r;
+      std::sort(rows.begin(), rows.end(), [&](std::size_t a, std::size_t b) {
+        return all[a * std::size_t(w)] < all[b * std::size_t(w)];
+      });
+      for (std::size_t r : rows)
+        for (int c = 0; c < nc; ++c) {
+          const double* t = &all[r * std::size_t(w) + 1 + 3 * std::size_t(c)];
+          out[std::size_t(c)].translational += t[0] + t[1];
+          out[std::size_t(c)].rotational += t[2];
+        }
+      for (auto& v : out)
+        v.total = v.translational + v.rotational;
+    }
+    return out;
+  }
+
+  // The J criterion (header): breaks the bonds across the next increment if J/h >= G_cr.
+  // Collective; returns the directed bonds broken on this rank.
+  Breakage advance() {
+    Breakage br;
+    const auto t = tip();
+    if (!(evaluate(contours(t))[0].total >= prm_.critical))
+      return br;
+    Crack seg;
+    for (int k = 0; k < 2; ++k) {
+      seg.a[k] = t[k];
+      seg.b[k] = t[k] + prm_.increment * d_[k];
+    }
+    br.bonds = break_crossing<Dim>(disc_.points, disc_.bonds, seg);
+    advances_ += 1;
+    return br;
+  }
+  double advances() const { return advances_; }
+
+ private:
+  Discretization<Dim>& disc_;
+  JIntegralParams prm_;
+  const Damage<Dim>& damage_;
+  MPI_Comm comm_;
+  const SolidState<Dim>* st_ = nullptr;
+  SolidParams sp_;
+  Vectors terms_;
+  double d_[2] = {1, 0};
+  double advances_ = 0;  // increments the crack advanced (J criterion; a restart global)
+};
+
+}  // namespace mupm
+
+#endif
