@@ -4,8 +4,9 @@
 # whose crack grows by bond breakage from step ~200 of 440 (restarted at 220, in the middle of
 # the growth): a straight run on 1 rank equals half the steps on 2 ranks followed by the rest on
 # 1 rank x 2 threads (fields and checkpoints compared byte for byte; for the crack, the broken
-# bonds too); the crack also in a saturated, hydro-mechanical plate, and with water in the crack
-# (fracture flow, both crack-water force models), whose water balance is checked too.
+# bonds too); the crack also by the J criterion (J and the broken bonds the same bits on 1 and 2
+# ranks), in a saturated, hydro-mechanical plate, and with water in the crack (fracture flow, both
+# crack-water force models), whose water balance is checked too.
 source "$(dirname "$0")/common.sh"
 # make_input XML FOLDER STEPS RESTART [SED_EXPR]: the input (a path in the source tree) with
 # its folder, step count and restart file replaced, a field output every 20 steps, and SED_EXPR.
@@ -46,12 +47,19 @@ with h5py.File(f"{name}-straight/checkpoint.h5") as a, h5py.File(f"{name}-second
         for field in a[grp]:
             assert a[grp][field][...].tobytes() == b[grp][field][...].tobytes(), field
     print("restart %s: checkpoints equal bit for bit" % name)
-    if "pair_force" in a["bonds"]:  # bond breakage: the crack grew in both halves of the run
-        import csv
-        rows = {int(float(r["step"])): r for r in csv.DictReader(open(f"{name}-straight/time_series.csv"))}
+    import csv
+    rows = {int(float(r["step"])): r for r in csv.DictReader(open(f"{name}-straight/time_series.csv"))}
+    if "pair_force" in a["bonds"] or "j_integral" in rows[0]:  # the crack grew in both halves
         broken = [float(rows[s]["broken_bonds"]) for s in (0, steps // 2, steps)]
         assert broken[0] < broken[1] < broken[2], broken
         print("restart %s: broken bonds %g -> %g (restart) -> %g" % (name, *broken))
+    if "j_integral" in rows[0]:  # J, a sum over ranks in global-id order: the same bits
+        for part in ("first", "second"):  # 2 ranks, then 1 rank x 2 threads
+            for r in csv.DictReader(open(f"{name}-{part}/time_series.csv")):
+                s = int(float(r["step"]))
+                for col in ("j_integral", "j_rotational", "broken_bonds", "crack_length"):
+                    assert rows[s][col] == r[col], (part, s, col, rows[s][col], r[col])
+        print("restart %s: J and the broken bonds equal bit for bit on 1 and 2 ranks" % name)
     # The energy and inflow bookkeeping is a sum over ranks: equal to round-off, not bit for
     # bit, across rank counts.
     def named(f):  # globals/<module>/<name> -> value
@@ -67,6 +75,8 @@ PY
 check solid inputs/quickstart.xml 40 7
 check coupled inputs/consolidation.xml 60 14
 check fracture tests/cli/fracture_small.xml 440 10
+# The J criterion (Algorithm 3): the crack advances by increments from step ~200.
+check fracture-j tests/cli/fracture_small.xml 440 11 's|value="Energy"/>|value="J-Integral"/>|; s|  <ParameterList name="Boundary Conditions">|  <ParameterList name="J-Integral"><Parameter name="Half Widths" type="Array(double)" value="{4, 5}"/></ParameterList>\n&|'
 # The same plate saturated, hydro-mechanical (soft water so that dt stays stable): breakage
 # with pore water (effective force state, strain-reference shift, fluid re-evaluation).
 check fracture-hm tests/cli/fracture_small.xml 440 15 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|' 

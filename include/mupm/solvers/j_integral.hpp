@@ -13,7 +13,7 @@
 // J/h of the first contour >= G_cr the crack advances one increment: the intact bonds that
 // cross the segment tip -> tip + Delta a d break (both copies: the test is on reference
 // positions, the same on every rank), at most one increment a step (the next step's J sees the
-// new tip and the new bond set).
+// new tip and the new bond set). A tip outside the real body (the crack ran through) stays.
 //
 // Sums over ranks: every point's terms are gathered with its global id and added in id order,
 // so that J, and with it the criterion's decision, is the same to the last bit on any number of
@@ -162,6 +162,10 @@ class JIntegral : public Module {
   Breakage advance() {
     Breakage br;
     const auto t = tip();
+    const auto& g = disc_.grid;
+    for (int k = 0; k < 2; ++k)  // the crack has run through the body
+      if (t[k] < g.origin[k] || t[k] > g.origin[k] + double(g.counts[k]) * g.dx)
+        return br;
     if (!(evaluate(contours(t))[0].total >= prm_.critical))
       return br;
     Crack seg;
