@@ -6,10 +6,11 @@
   mupm_plot.py series OUTPUT_DIR COLUMN [COLUMN...] [-o out.png]
       columns of time_series.csv against time.
   mupm_plot.py compare COLUMN OUTPUT_DIR[:LABEL] [OUTPUT_DIR[:LABEL] ...] [--time-scale S]
-                       [--xlabel TEXT] [--reference X Y [X Y ...]] [--reference-label TEXT]
-                       [-o out.png]
-      one column of several runs against time x S (e.g. the load of a ramp), with reference
-      points (X, Y) such as a paper's values.
+                       [--x-column X] [--xlabel TEXT] [--reference X Y [X Y ...]]
+                       [--reference-label TEXT] [-o out.png]
+      one column of several runs against time x S (e.g. the load of a ramp), or against another
+      column x S (--x-column, e.g. crack_length with S = 1/W for a/W), with reference points
+      (X, Y) such as a paper's values.
 """
 import argparse
 import csv
@@ -81,7 +82,9 @@ def plot_compare(args):
         rows = list(csv.DictReader(open(os.path.join(d, "time_series.csv"))))
         if args.column not in rows[0]:
             raise SystemExit("%s: no column %s in time_series.csv" % (d, args.column))
-        ax.plot([float(r["time"]) * args.time_scale for r in rows],
+        if args.x_column and args.x_column not in rows[0]:
+            raise SystemExit("%s: no column %s in time_series.csv" % (d, args.x_column))
+        ax.plot([float(r[args.x_column or "time"]) * args.time_scale for r in rows],
                 [float(r[args.column]) for r in rows], label=label or d)
     if args.reference:
         if len(args.reference) % 2:
@@ -113,6 +116,7 @@ def main():
     c.add_argument("column")
     c.add_argument("runs", nargs="+", metavar="OUTPUT_DIR[:LABEL]")
     c.add_argument("--time-scale", type=float, default=1.0)
+    c.add_argument("--x-column", default="")
     c.add_argument("--xlabel", default="time [s]")
     c.add_argument("--reference", type=float, nargs="+")
     c.add_argument("--reference-label", default="reference")

@@ -140,23 +140,6 @@ class Damage : public Module {
     return tip;
   }
 
- private:
-  // s = (x_i - T).d of a fracture point of the real body away from the pre-crack (header).
-  struct Ahead {
-    Vectors x;
-    Bytes frac;
-    Flags flags;
-    double T[3] = {0, 0, 0}, d[3] = {0, 0, 0};
-    KOKKOS_INLINE_FUNCTION bool operator()(std::size_t i, double& s) const {
-      if (!frac(i) || (flags(i) & (kFlagPreCrack | kFlagBoundaryLayer)))
-        return false;
-      s = 0;
-      for (int k = 0; k < Dim; ++k)
-        s += (x(i, k) - T[k]) * d[k];
-      return true;
-    }
-  };
-
   // Length of the segment S -> T inside the real body (a box).
   double inside_length(const double* S, const double* T) const {
     const auto& g = disc_.grid;
@@ -178,6 +161,23 @@ class Damage : public Module {
     }
     return hi > lo ? (hi - lo) * std::sqrt(len2) : 0.0;
   }
+
+ private:
+  // s = (x_i - T).d of a fracture point of the real body away from the pre-crack (header).
+  struct Ahead {
+    Vectors x;
+    Bytes frac;
+    Flags flags;
+    double T[3] = {0, 0, 0}, d[3] = {0, 0, 0};
+    KOKKOS_INLINE_FUNCTION bool operator()(std::size_t i, double& s) const {
+      if (!frac(i) || (flags(i) & (kFlagPreCrack | kFlagBoundaryLayer)))
+        return false;
+      s = 0;
+      for (int k = 0; k < Dim; ++k)
+        s += (x(i, k) - T[k]) * d[k];
+      return true;
+    }
+  };
 
   Discretization<Dim>& disc_;
   double critical_damage_;

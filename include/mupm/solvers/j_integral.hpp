@@ -67,7 +67,8 @@ class JIntegral : public Module {
     if (prm_.criterion)
       g("advances", advances_);
   }
-  // j_integral, j_translational, j_rotational of the first contour; j_integral_<k> of contour k.
+  // j_integral, j_translational, j_rotational of the first contour; j_integral_<k> of contour k;
+  // with the J criterion j_crack_length, the pre-crack's part inside the body + n Delta a.
   void series(SeriesRow& row) const override {
     const auto v = evaluate();
     row("j_integral", v[0].total);
@@ -75,6 +76,11 @@ class JIntegral : public Module {
     row("j_rotational", v[0].rotational);
     for (std::size_t k = 1; k < v.size(); ++k)
       row("j_integral_" + std::to_string(k + 1), v[k].total);
+    if (prm_.criterion) {  // the crack the criterion has grown: the pre-crack inside the body + n
+                           // da
+      const Crack& c = disc_.grid.cracks.front();
+      row("j_crack_length", damage_.inside_length(c.a, c.b) + advances_ * prm_.increment);
+    }
   }
 
   // The tip now (header). Collective.
