@@ -335,7 +335,9 @@ RCP<ParameterList> valid_parameters() {
           contour_units_options().validator());
     j.set("Crack Increment", 0.0,
           "Delta a [m] by which the J criterion (Fracture->Bond Breakage = J-Integral) advances "
-          "the crack each time J/h >= Critical Energy Release Rate (0: one Spacing).",
+          "the crack each time J/h >= Critical Energy Release Rate (0: one Spacing; at most the "
+          "smallest contour half size). After an advance the next waits Delta a / c_R, c_R the "
+          "skeleton's Rayleigh wave speed (the tip's speed cap).",
           at_least(0.0));
   }
   {
@@ -604,6 +606,13 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
                          " has a half size of " + std::to_string(v * unit) +
                          " m, below one Spacing (" + std::to_string(dx) +
                          " m): a contour must hold the tip and the points around it.");
+  const double inc = j.get<double>("Crack Increment");
+  for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
+    if (criterion && std::min(w[k], h[k]) * unit < inc)
+      throw InputError("Error, " + path_of(j, "Crack Increment") + " = " + std::to_string(inc) +
+                       " m exceeds the half size of contour " + std::to_string(k + 1) + " (" +
+                       std::to_string(std::min(w[k], h[k]) * unit) +
+                       " m): an increment must stay inside the contours (it is in metres).");
 }
 
 void check_region(const ParameterList& c, const ParameterList& regions,

@@ -188,6 +188,12 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.j_integral.critical = fracture.get<double>("Critical Energy Release Rate");
   const double inc = j.get<double>("Crack Increment");
   m.j_integral.increment = inc > 0 ? inc : m.grid.dx;
+  // The tip's speed cap (include/mupm/solvers/j_integral.hpp): the Rayleigh wave speed of the
+  // skeleton, c_R = c_s (0.862 + 1.14 nu)/(1 + nu) (Viktorov's fit), c_s = sqrt(mu / rho) with
+  // the initial mixture density of saturated pores (the heaviest: the lowest speed).
+  const double rho = mixture_density(m.porosity, m.solid_density, 1.0, m.fluid.water_density);
+  const double nu = m.solid.law.poisson();
+  m.j_integral.max_speed = std::sqrt(m.solid.law.mu / rho) * (0.862 + 1.14 * nu) / (1 + nu);
 
   m.boundary_conditions = boundary_conditions_from_input(input);
   m.initial_conditions = initial_conditions_from_input(input);

@@ -241,7 +241,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
           j->attach(solid->state(), solid->params());
           solid->keep_pore_part();
           if (model.j_integral.criterion)
-            solid->set_crack_driver([j] { return j->advance(); });
+            solid->set_crack_driver([j](double t) { return j->advance(t); });
         }
         ph.mechanics = std::move(solid);
         break;

@@ -188,16 +188,17 @@ TEST(JIntegral, CriterionAdvancesOneIncrementAtGcr) {
   high.attach(p.st, p.prm);
   const long long before = crossing_bonds(p.disc, 0.04, 0.04 + dx, 0.04);
   ASSERT_GT(before, 0);
-  long long n = high.advance().bonds;
+  long long n = high.advance(0.0).bonds;
   MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
   EXPECT_EQ(n, 0);
   EXPECT_EQ(high.advances(), 0);
   EXPECT_EQ(crossing_bonds(p.disc, 0.04, 0.04 + dx, 0.04), before);
 
   jp.critical = 0.999 * J;  // below J: one increment
+  jp.max_speed = 1000;      // m/s: the next advance no earlier than dx / 1000 m/s = 1 us later
   JIntegral<2> low(p.disc, jp, damage, MPI_COMM_WORLD);
   low.attach(p.st, p.prm);
-  n = low.advance().bonds;
+  n = low.advance(0.0).bonds;
   MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
   EXPECT_EQ(n, before);  // every directed bond across the increment, i.e. both copies
   EXPECT_EQ(before % 2, 0);
@@ -206,6 +207,17 @@ TEST(JIntegral, CriterionAdvancesOneIncrementAtGcr) {
   EXPECT_EQ(low.advances(), 1);
   EXPECT_DOUBLE_EQ(low.tip()[0], 0.04 + dx);
   EXPECT_DOUBLE_EQ(low.tip()[1], 0.04);
+  // The speed cap: J at the new tip (the old field) is still above G_cr, but the next increment
+  // waits dx / c_R.
+  ASSERT_GE(low.evaluate()[0].total, jp.critical);
+  n = low.advance(0.9e-6).bonds;
+  MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(n, 0);
+  EXPECT_EQ(low.advances(), 1);
+  n = low.advance(1.0e-6).bonds;
+  MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_GT(n, 0);
+  EXPECT_EQ(low.advances(), 2);
 }
 
 // A homogeneous strain without a crack's opening stores energy but releases none: J = 0 on a
@@ -317,7 +329,7 @@ std::vector<JIntegral<2>::Value> j_of(StaticPlate& P, const std::vector<double>&
 
 // The LEFM check of the issue: a single-edge-cracked strip (height 3W) in tension, mu_c and l
 // small: J against K_I^2 (1 - nu^2)/E with K_I = sigma sqrt(pi a) F(a/W), at a/W = 0.3 and 0.5,
-// on three contours.
+// on four contours.
 class SentJ : public ::testing::TestWithParam<double> {};
 
 TEST_P(SentJ, MatchesLefm) {
@@ -327,7 +339,9 @@ TEST_P(SentJ, MatchesLefm) {
   tension(*P, sigma);
   const int its = P->sp.solve();
   ASSERT_GT(its, 0) << "static solve did not converge";
-  const auto v = j_of(*P, {8, 11, 14});
+  // The fourth contour reaches past the left face at a/W = 0.3 (it runs along the free face
+  // there: the W term of the face, include/mupm/kernels/j_integral.hpp).
+  const auto v = j_of(*P, {8, 11, 14, 22});
   const double a = aw * P->W;
   const double K = sigma * std::sqrt(M_PI * a) * sent_factor(aw);
   const double nu = kClassical.poisson();
@@ -444,9 +458,10 @@ TEST_P(Example2Reduced, JFallsAsLengthScaleGrows) {
     }
     ASSERT_GT(P->sp.solve(), 0);
     const auto v = j_of(*P, {12, 16});
-    std::printf("Example 2 reduced, mode %s, l = delta = %g mm: J = %.5g, %.5g (contours 1, 2; "
-                "micro-rotational %.3g)\n",
-                mode2 ? "II" : "I", l * 1e3, v[0].total, v[1].total, v[0].rotational);
+    std::printf(
+        "Example 2 reduced, mode %s, l = delta = %g mm: J = %.5g, %.5g (contours 1, 2; "
+        "micro-rotational %.3g)\n",
+        mode2 ? "II" : "I", l * 1e3, v[0].total, v[1].total, v[0].rotational);
     EXPECT_NEAR(v[1].total / v[0].total, 1.0, 0.005);
     J.push_back(v[0].total);
   }

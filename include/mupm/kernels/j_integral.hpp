@@ -31,7 +31,14 @@
 // just inside and just outside, each at dx/2 from it): each of them adds W_i dx (n.d)/2 for the
 // part of the edge its row spans. W is the point's energy density with the stabilization
 // energy (solid pass 1, SolidState::energy / V). Bonds across the crack are broken and carry no
-// power; an edge that crosses the crack is cut by it.
+// power; an edge that crosses the crack is cut by it. A contour reaching past a face of the body
+// (the crack's mouth, or the face ahead of a long crack) runs along that face inside the box:
+// there no bond crosses, and the W term is int W n.d ds along the face, with the W of the
+// points of the last row (dx/2 inside it) at full weight.
+//
+// Left out, as in the paper's J: kinetic energy (J is that of a static field; in a running crack
+// the contours differ), and the crack water's forces on the faces (Fracture Flow): with water in
+// the crack J is not path-independent.
 //
 // Force state: the one the bond energy uses (Fracture->Bond Energy Force State): with pore water
 // and Effective (default), the skeleton's, T-bar = T + S_r p* K^-1 xi (the paper's eqs 23, 30:
@@ -56,6 +63,7 @@ struct JIntegralParams {
   bool criterion = false;                   // Fracture->Bond Breakage = J-Integral
   double critical = 0;                      // G_cr [J/m^2]
   double increment = 0;                     // Delta a [m]
+  double max_speed = 0;                     // the tip's speed cap c_R [m/s] (0: none)
 };
 
 // Contours (faces on cell faces), the crack direction d (unit), and the thickness h.
@@ -65,6 +73,7 @@ struct JContours {
   double d[2] = {1, 0};
   double thickness = 1;
   double dx = 0;
+  Box body;  // the lattice (real body and boundary layers): its faces are free or held faces
 };
 
 // Per owned point i and contour c: out(i, 3c + 0) the W term, 3c + 1 the u terms, 3c + 2 the
@@ -101,15 +110,25 @@ inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const Sol
         for (int ci = 0; ci < c.count; ++ci) {
           const Box& b = c.box[ci];
           double w = 0, tr = 0, rot = 0;
-          // W term: the points at dx/2 from an edge, within the edge's span.
+          // W term: the points at dx/2 from an edge, within the edge's span; an edge at or
+          // beyond the body's face runs along the face, where the last row carries W (header).
           for (int a = 0; a < Dim; ++a) {
             const int o = 1 - a;  // the edge runs along axis o
             if (!(xi_[o] > b.lo[o] && xi_[o] < b.hi[o]))
               continue;
-            if (std::abs(xi_[a] - b.hi[a]) < c.dx)
-              w += 0.5 * Wi * c.dx * c.d[a];  // edge x_a = hi: n = +e_a
-            if (std::abs(xi_[a] - b.lo[a]) < c.dx)
-              w -= 0.5 * Wi * c.dx * c.d[a];  // edge x_a = lo: n = -e_a
+            const double inside = 0.25 * c.dx;  // edges and faces lie on cell faces
+            if (b.hi[a] < c.body.hi[a] - inside) {
+              if (std::abs(xi_[a] - b.hi[a]) < c.dx)
+                w += 0.5 * Wi * c.dx * c.d[a];  // edge x_a = hi: n = +e_a
+            } else if (std::abs(xi_[a] - (c.body.hi[a] - 0.5 * c.dx)) < 0.5 * c.dx) {
+              w += Wi * c.dx * c.d[a];  // along the face x_a = hi
+            }
+            if (b.lo[a] > c.body.lo[a] + inside) {
+              if (std::abs(xi_[a] - b.lo[a]) < c.dx)
+                w -= 0.5 * Wi * c.dx * c.d[a];  // edge x_a = lo: n = -e_a
+            } else if (std::abs(xi_[a] - (c.body.lo[a] + 0.5 * c.dx)) < 0.5 * c.dx) {
+              w -= Wi * c.dx * c.d[a];  // along the face x_a = lo
+            }
           }
           // Bond terms: i in B1 (inside), j in B2 (outside).
           if (in_box<Dim>(b, xi_, 0.0)) {

@@ -14,6 +14,10 @@
 // cross the segment tip -> tip + Delta a d break (both copies: the test is on reference
 // positions, the same on every rank), at most one increment a step (the next step's J sees the
 // new tip and the new bond set). A tip outside the real body (the crack ran through) stays.
+// Speed cap (not in the paper's Algorithm 3): after an advance the next waits Delta a / c_R,
+// c_R the skeleton's Rayleigh wave speed, the limit of a running mode I crack's speed. Without
+// it the crack runs at Delta a / dt (above the wave speeds) for as long as the contours, whose
+// edges the field of the last increment has not reached yet, still show J >= G_cr.
 //
 // Sums over ranks: every point's terms are gathered with its global id and added in id order,
 // so that J, and with it the criterion's decision, is the same to the last bit on any number of
@@ -26,6 +30,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -64,8 +69,10 @@ class JIntegral : public Module {
 
   const char* name() const override { return "j_integral"; }
   void globals(GlobalRefs& g) override {
-    if (prm_.criterion)
+    if (prm_.criterion) {
       g("advances", advances_);
+      g("last_advance_time", last_advance_);
+    }
   }
   // j_integral, j_translational, j_rotational of the first contour; j_integral_<k> of contour k;
   // with the J criterion j_crack_length, the pre-crack's part inside the body + n Delta a.
@@ -105,10 +112,15 @@ class JIntegral : public Module {
     auto face = [&](int k, double v) {
       return g.origin[k] + std::round((v - g.origin[k]) / g.dx) * g.dx;
     };
+    for (int k = 0; k < 2; ++k) {
+      jc.body.lo[k] = g.origin[k] - g.layers[k][0] * g.dx;
+      jc.body.hi[k] = g.origin[k] + double(g.counts[k] + g.layers[k][1]) * g.dx;
+    }
     for (int c = 0; c < jc.count; ++c)
-      for (int k = 0; k < 2; ++k) {
-        jc.box[c].lo[k] = face(k, tip[k] - prm_.half[c][k]);
-        jc.box[c].hi[k] = face(k, tip[k] + prm_.half[c][k]);
+      for (int k = 0; k < 2; ++k) {  // the tip to a face first, so that the box is centred on it
+        const double t = face(k, tip[k]), h = std::round(prm_.half[c][k] / g.dx) * g.dx;
+        jc.box[c].lo[k] = t - h;
+        jc.box[c].hi[k] = t + h;
       }
     return jc;
   }
@@ -118,6 +130,8 @@ class JIntegral : public Module {
   std::vector<Value> evaluate(const JContours& jc) const {
     const int nc = jc.count;
     std::vector<Value> out(static_cast<std::size_t>(nc));
+    if (!st_)
+      throw std::logic_error("JIntegral::evaluate: no solid state attached (JIntegral::attach)");
     if constexpr (Dim == 2) {
       const auto& p = disc_.points;
       j_integral_terms(p, disc_.bonds, sp_, *st_, jc, terms_);
@@ -163,17 +177,22 @@ class JIntegral : public Module {
     return out;
   }
 
-  // The J criterion (header): breaks the bonds across the next increment if J/h >= G_cr.
-  // Collective; returns the directed bonds broken on this rank.
-  Breakage advance() {
+  // The J criterion (header) at time `time`: breaks the bonds across the next increment if
+  // J/h >= G_cr and the speed cap allows. Collective; returns the directed bonds broken on this
+  // rank.
+  Breakage advance(double time) {
     Breakage br;
     const auto t = tip();
     const auto& g = disc_.grid;
     for (int k = 0; k < 2; ++k)  // the crack has run through the body
-      if (t[k] < g.origin[k] || t[k] > g.origin[k] + double(g.counts[k]) * g.dx)
+      if (t[k] < g.origin[k] || t[k] >= g.origin[k] + double(g.counts[k]) * g.dx)
         return br;
+    if (advances_ > 0 && prm_.max_speed > 0 &&
+        time - last_advance_ < prm_.increment / prm_.max_speed * (1 - 1e-9))
+      return br;
     if (!(evaluate(contours(t))[0].total >= prm_.critical))
       return br;
+    last_advance_ = time;
     Crack seg;
     for (int k = 0; k < 2; ++k) {
       seg.a[k] = t[k];
@@ -194,7 +213,8 @@ class JIntegral : public Module {
   SolidParams sp_;
   Vectors terms_;
   double d_[2] = {1, 0};
-  double advances_ = 0;  // increments the crack advanced (J criterion; a restart global)
+  double advances_ = 0;      // increments the crack advanced (J criterion; a restart global)
+  double last_advance_ = 0;  // time of the last advance (J criterion; a restart global)
 };
 
 }  // namespace mupm

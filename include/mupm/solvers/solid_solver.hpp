@@ -109,9 +109,9 @@ class SolidSolver : public Mechanics {
   bool breaks() const { return set_.fracture.criterion != BondBreaking::None; }
   bool energy_criterion() const { return set_.fracture.criterion == BondBreaking::Energy; }
   // What breaks bonds besides the energy criterion (the J criterion, include/mupm/solvers/
-  // j_integral.hpp): called after the step's forces, before the velocity update; collective;
-  // returns the directed bonds it broke on this rank.
-  void set_crack_driver(std::function<Breakage()> driver) { driver_ = std::move(driver); }
+  // j_integral.hpp): called with the step's end time after its forces, before the velocity
+  // update; collective; returns the directed bonds it broke on this rank.
+  void set_crack_driver(std::function<Breakage(double)> driver) { driver_ = std::move(driver); }
   // The pore-water part of the force state kept apart (SolidState::P1w) for the J-integral's
   // effective force state too, without breakage (before initialize).
   void keep_pore_part() { keep_pore_part_ = true; }
@@ -245,7 +245,7 @@ class SolidSolver : public Mechanics {
       w[4] = br.energy;
     }
     if (driver_)
-      w[3] += double(driver_().bonds);
+      w[3] += double(driver_(t + dt).bonds);
     MPI_Allreduce(MPI_IN_PLACE, w, 6, MPI_DOUBLE, MPI_SUM, comm_);
     work_ += w[0];
     dissipation_ += w[1];
@@ -707,12 +707,12 @@ class SolidSolver : public Mechanics {
   Vectors f_old_, l_old_;   // forces of the old bond set at a breakage
   Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
-  double fracture_energy_ = 0;        // strain energy lost to bond breakage since t = 0 [J]
-  double bond_energy_released_ = 0;   // W V_i V_j of the bonds broken since t = 0 [J]
-  double broken_pairs_ = 0;           // bond pairs broken since t = 0 (a restart global)
-  bool pressure_ = false;             // breakage run with pore pressure (initialize)
-  bool keep_pore_part_ = false;       // P1w for the J-integral (keep_pore_part)
-  std::function<Breakage()> driver_;  // the J criterion (set_crack_driver)
+  double fracture_energy_ = 0;              // strain energy lost to bond breakage since t = 0 [J]
+  double bond_energy_released_ = 0;         // W V_i V_j of the bonds broken since t = 0 [J]
+  double broken_pairs_ = 0;                 // bond pairs broken since t = 0 (a restart global)
+  bool pressure_ = false;                   // breakage run with pore pressure (initialize)
+  bool keep_pore_part_ = false;             // P1w for the J-integral (keep_pore_part)
+  std::function<Breakage(double)> driver_;  // the J criterion (set_crack_driver), at time t
 };
 
 }  // namespace mupm
