@@ -336,9 +336,14 @@ RCP<ParameterList> valid_parameters() {
     j.set("Crack Increment", 0.0,
           "Delta a [m] by which the J criterion (Fracture->Bond Breakage = J-Integral) advances "
           "the crack each time J/h >= Critical Energy Release Rate (0: one Spacing; at most the "
-          "smallest contour half size). After an advance the next waits Delta a / c_R, c_R the "
-          "skeleton's Rayleigh wave speed (the tip's speed cap).",
+          "smallest contour half size).",
           at_least(0.0));
+    j.set("Speed Cap", true,
+          "J criterion: after an advance the next waits Delta a / c_R, c_R = c_s (0.862 + "
+          "1.14 nu)/(1 + nu) the skeleton's Rayleigh wave speed at the initial density (a "
+          "running mode I crack's limit). false: an advance whenever J/h >= G_cr, at most one a "
+          "step (the paper's Algorithm 3), which lets the crack run at Delta a / dt while the "
+          "contours still show the field of before the last increment.");
   }
   {
     ParameterList& b =

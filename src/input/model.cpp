@@ -193,7 +193,8 @@ Model<Dim> model_from_input(const ParameterList& input) {
   // the initial mixture density of saturated pores (the heaviest: the lowest speed).
   const double rho = mixture_density(m.porosity, m.solid_density, 1.0, m.fluid.water_density);
   const double nu = m.solid.law.poisson();
-  m.j_integral.max_speed = std::sqrt(m.solid.law.mu / rho) * (0.862 + 1.14 * nu) / (1 + nu);
+  if (j.get<bool>("Speed Cap"))
+    m.j_integral.max_speed = std::sqrt(m.solid.law.mu / rho) * (0.862 + 1.14 * nu) / (1 + nu);
 
   m.boundary_conditions = boundary_conditions_from_input(input);
   m.initial_conditions = initial_conditions_from_input(input);
