@@ -107,17 +107,23 @@ JIntegralParams contours(std::vector<double> half_spacings, double dx) {
   return jp;
 }
 
+// The K-field of kClassical with its tip at the centre of cracked_plate(80, ...).
+KField centre_field(bool mode2) {
+  KField f;
+  f.mode2 = mode2;
+  f.mu = kClassical.mu;
+  f.kappa = 3 - 4 * kClassical.poisson();
+  f.xt = f.yt = 0.04;
+  return f;
+}
+
 class KFieldJ : public ::testing::TestWithParam<bool> {};
 
 TEST_P(KFieldJ, MatchesLefmOnEveryContour) {
   const bool mode2 = GetParam();
   Plate p = cracked_plate(80, kClassical);
   const auto& law = kClassical;
-  KField f;
-  f.mode2 = mode2;
-  f.mu = law.mu;
-  f.kappa = 3 - 4 * law.poisson();
-  f.xt = f.yt = 0.04;
+  const KField f = centre_field(mode2);
   impose(p, f);
   Damage<2> damage(p.disc, 0.3, MPI_COMM_WORLD);
   damage.update();
@@ -169,11 +175,7 @@ long long crossing_bonds(const Discretization<2>& disc, double x0, double x1, do
 // copies); with G_cr just above J nothing happens.
 TEST(JIntegral, CriterionAdvancesOneIncrementAtGcr) {
   Plate p = cracked_plate(80, kClassical);
-  KField f;
-  f.mu = kClassical.mu;
-  f.kappa = 3 - 4 * kClassical.poisson();
-  f.xt = f.yt = 0.04;
-  impose(p, f);
+  impose(p, centre_field(false));
   Damage<2> damage(p.disc, 0.3, MPI_COMM_WORLD);
   damage.update();
   JIntegralParams jp = contours({10, 15}, p.g.dx);
