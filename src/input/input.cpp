@@ -202,8 +202,29 @@ RCP<ParameterList> valid_parameters() {
     ParameterList& m =
         pl->sublist("Materials", false, "The solid (Solver->Physics = Micropolar Solid).");
     m.set("Model", std::string("Micropolar Elastic"),
-          "Constitutive model: Micropolar Elastic (eqs 80-81).",
+          "Constitutive model: Micropolar Elastic (eqs 80-81), or Micropolar Drucker-Prager "
+          "(eqs 82-95: the elastic law plus the Drucker-Prager yield surface and plastic "
+          "potential as the paper writes them, non-associative flow, linear softening of the "
+          "cohesion down to a residual one; plane strain in 2D).",
           constitutive_model_options().validator());
+    m.set("Friction Angle", 30.0,
+          "Drucker-Prager friction angle phi [degrees] in [0, 90) (eqs 89-90; Micropolar "
+          "Drucker-Prager).",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 89.999)));
+    m.set("Dilation Angle", 0.0,
+          "Dilation angle psi [degrees] in [0, 90) of the plastic potential (eqs 88, 91; "
+          "Micropolar Drucker-Prager). psi = phi is associative flow.",
+          rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 89.999)));
+    m.set("Cohesion", 0.0, "Initial cohesion c_0 [Pa] (eq 92; Micropolar Drucker-Prager: > 0).",
+          at_least(0.0));
+    m.set("Residual Cohesion", 0.0,
+          "Residual cohesion c_r [Pa]: softening stops at c = c_r (Micropolar Drucker-Prager; "
+          "<= Cohesion).",
+          at_least(0.0));
+    m.set("Softening Modulus", 0.0,
+          "h [Pa] of c = c_0 + h eps-hat^p (eq 92; Micropolar Drucker-Prager): negative softens, "
+          "positive hardens. eps-hat^p is eq 95 with its curvature term weighted by l^2 "
+          "(2/3 l^2 dkappa^p : dkappa^p), which makes it the work conjugate of q.");
     m.set("Bulk Modulus", 0.0, "Drained bulk modulus K [Pa] (> 0 for a solid).", at_least(0.0));
     m.set("Shear Modulus", 0.0, "Shear modulus mu [Pa] (> 0 for a solid).", at_least(0.0));
     m.set("Micropolar Shear Modulus", 0.0, "Cosserat coupling modulus mu_c [Pa] (eq 80).",
@@ -795,6 +816,17 @@ void check_dimension_arrays(ParameterList& input) {
                          " must be > 0 for Solver->Physics = " + physics + ".");
     const auto sm = stabilization_modulus_options()(m.get<std::string>("Stabilization Modulus"));
     const double K = m.get<double>("Bulk Modulus"), mu = m.get<double>("Shear Modulus");
+    if (constitutive_model_options()(m.get<std::string>("Model")) ==
+        ConstitutiveModel::MicropolarDruckerPrager) {
+      const double c0 = m.get<double>("Cohesion"), cr = m.get<double>("Residual Cohesion");
+      if (!(c0 > 0))
+        throw InputError("Error, " + path_of(m, "Cohesion") +
+                         " must be > 0 for Materials->Model = Micropolar Drucker-Prager.");
+      if (cr > c0)
+        throw InputError("Error, " + path_of(m, "Residual Cohesion") + " = " + std::to_string(cr) +
+                         " Pa exceeds " + path_of(m, "Cohesion") + " = " + std::to_string(c0) +
+                         " Pa: softening ends at the residual cohesion.");
+    }
     if (sm == StabilizationModulus::Eq71 && (dim == 2 || mu - (K - 2 * mu / 3) <= 0))
       throw InputError("Error, " + path_of(m, "Stabilization Modulus") + " = Eq 71 " +
                        (dim == 2 ? std::string("is a 3D formula")

@@ -23,7 +23,8 @@ const Options<Staggering>& staggering_options() {
 }
 const Options<ConstitutiveModel>& constitutive_model_options() {
   static const Options<ConstitutiveModel> o(
-      "Model", {{"Micropolar Elastic", ConstitutiveModel::MicropolarElastic}});
+      "Model", {{"Micropolar Elastic", ConstitutiveModel::MicropolarElastic},
+                {"Micropolar Drucker-Prager", ConstitutiveModel::MicropolarDruckerPrager}});
   return o;
 }
 const Options<StabilizationModulus>& stabilization_modulus_options() {
@@ -134,6 +135,12 @@ Model<Dim> model_from_input(const ParameterList& input) {
           materials.get<double>("Micropolar Shear Modulus"), materials.get<double>("Length Scale")),
       m.grid, materials.get<double>("Stabilization"),
       stabilization_modulus_options()(materials.get<std::string>("Stabilization Modulus")));
+  const double deg = kPi / 180;
+  m.plasticity.friction = materials.get<double>("Friction Angle") * deg;
+  m.plasticity.dilation = materials.get<double>("Dilation Angle") * deg;
+  m.plasticity.cohesion = materials.get<double>("Cohesion");
+  m.plasticity.residual = materials.get<double>("Residual Cohesion");
+  m.plasticity.softening = materials.get<double>("Softening Modulus");
   m.solid_density = materials.get<double>("Solid Density");
   m.porosity = materials.get<double>("Porosity");
 

@@ -227,25 +227,31 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   if (!model.j_integral.half.empty())
     ph.j_integral = std::make_unique<JIntegral<Dim>>(disc, model.j_integral, *ph.damage, mpi);
   if (has_solid(physics)) {
-    typename SolidSolver<Dim>::Settings settings;
+    SolidSettings settings;
     settings.rho_s = model.solid_density;
     settings.rho_w = model.fluid.water_density;
     settings.gravity = model.gravity;
     settings.damping = model.damping;
     settings.fracture = model.fracture;
-    switch (model.constitutive_model) {
-      case ConstitutiveModel::MicropolarElastic: {
-        auto solid = std::make_unique<SolidSolver<Dim, MicropolarElastic>>(
-            disc, model.solid, model.boundary_conditions, settings, mpi);
-        if (auto* j = ph.j_integral.get()) {
-          j->attach(solid->state(), solid->params());
-          solid->keep_pore_part();
-          if (model.j_integral.criterion)
-            solid->set_crack_driver([j](double t) { return j->advance(t); });
-        }
-        ph.mechanics = std::move(solid);
-        break;
+    auto attach = [&](auto solid) {
+      if (auto* j = ph.j_integral.get()) {
+        j->attach(solid->state(), solid->params());
+        solid->keep_pore_part();
+        if (model.j_integral.criterion)
+          solid->set_crack_driver([j](double t) { return j->advance(t); });
       }
+      ph.mechanics = std::move(solid);
+    };
+    switch (model.constitutive_model) {
+      case ConstitutiveModel::MicropolarElastic:
+        attach(std::make_unique<SolidSolver<Dim, MicropolarElastic>>(
+            disc, model.solid, model.boundary_conditions, settings, mpi));
+        break;
+      case ConstitutiveModel::MicropolarDruckerPrager:
+        attach(std::make_unique<SolidSolver<Dim, MicropolarDruckerPrager<Dim>>>(
+            disc, model.solid, model.boundary_conditions, settings, mpi,
+            MicropolarDruckerPrager<Dim>(model.solid.law, model.plasticity, disc.points)));
+        break;
     }
   } else if (physics == Physics::KinematicsOnly) {
     ph.mechanics = std::make_unique<Kinematics<Dim>>(disc);

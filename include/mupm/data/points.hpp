@@ -79,11 +79,19 @@ struct Points {
   Scalars aperture;              // crack aperture a_f [m] (eqs 38-39) of points with broken bonds
   Scalars bond_energy_released;  // energy released by the point's broken bonds [J], half of
                                  // W V_i V_j per bond (the other half is at the other end)
-  // Constitutive state: effective stress, couple stress, equivalent plastic strain.
-  Vectors stress;                 // sigma-bar [n][Dim*Dim], row-major, non-symmetric
-  Vectors couple_stress;          // m [n][RotDim*Dim]
-  Scalars plastic_strain;         // equivalent plastic strain (eq 95)
-  Vectors plastic_strain_tensor;  // eps^p [n][Dim*Dim], row-major (the additive split, eq 82)
+  // Constitutive state: effective stress, couple stress, and the plastic state of Materials->
+  // Model = Micropolar Drucker-Prager (include/mupm/laws/micropolar_drucker_prager.hpp; zero
+  // with the elastic law).
+  Vectors stress;                     // sigma-bar [n][Dim*Dim], row-major, non-symmetric
+  Vectors couple_stress;              // m [n][RotDim*Dim]
+  Vectors plastic_strain;             // eps^p [n][Dim*Dim], row-major (the additive split, eq 82)
+  Scalars plastic_strain_zz;          // eps^p_zz of plane strain (2D; 3D has it in eps^p)
+  Vectors plastic_wryness;            // kappa^p [n][RotDim*Dim] (eq 83)
+  Scalars equivalent_plastic_strain;  // eps-hat^p (eq 95)
+  Scalars plastic_volumetric_strain;  // tr eps^p (3D trace), positive = dilation
+  Scalars cohesion;                   // c (eq 92)
+  Scalars stress_zz;                  // sigma_zz of the plastic law (plane strain)
+  Vectors plastic_step_start;         // the plastic state and stress at the step's start (law)
 
   // The registry: f(view, spec) for every field, in this order (the checkpoint's and the
   // output list's). Traits: kConstant (sent to the ghosts once), kGhosted (refreshed on the
@@ -187,8 +195,14 @@ struct Points {
     f(p.bond_energy_released, FieldSpec{"bond_energy_released", 1, kState});
     f(p.stress,            FieldSpec{"stress", D * D, kState});
     f(p.couple_stress,     FieldSpec{"couple_stress", R * D, kState});
-    f(p.plastic_strain,    FieldSpec{"plastic_strain", 1, kState});
-    f(p.plastic_strain_tensor, FieldSpec{"plastic_strain_tensor", D * D, kState});
+    f(p.plastic_strain,    FieldSpec{"plastic_strain", D * D, kState});
+    f(p.plastic_strain_zz, FieldSpec{"plastic_strain_zz", 1, kCheckpoint});
+    f(p.plastic_wryness,   FieldSpec{"plastic_wryness", R * D, kState});
+    f(p.equivalent_plastic_strain, FieldSpec{"equivalent_plastic_strain", 1, kState});
+    f(p.plastic_volumetric_strain, FieldSpec{"plastic_volumetric_strain", 1, kState});
+    f(p.cohesion,          FieldSpec{"cohesion", 1, kState});
+    f(p.stress_zz,         FieldSpec{"stress_zz", 1, kCheckpoint});
+    f(p.plastic_step_start, FieldSpec{"plastic_step_start", 2 * D * D + 2 * R * D + 3, kCheckpoint});
     // clang-format on
   }
 };

@@ -14,6 +14,7 @@
 #include "mupm/kernels/fluid.hpp"
 #include "mupm/kernels/j_integral.hpp"
 #include "mupm/kernels/solid.hpp"
+#include "mupm/laws/micropolar_drucker_prager.hpp"
 #include "mupm/mesh/grid.hpp"
 
 namespace mupm {
@@ -73,6 +74,7 @@ struct Model {
   RunSettings run;
   ConstitutiveModel constitutive_model = ConstitutiveModel::MicropolarElastic;
   SolidParams solid;
+  DruckerPragerParams plasticity;  // Materials->Model = Micropolar Drucker-Prager
   double solid_density = 2000;  // rho_s
   double damping = 0;           // Solver->Damping
   FluidParams fluid;

@@ -27,7 +27,7 @@ inline bool has_fluid(Physics p) {
 // Solver->Staggering.
 enum class Staggering { SolidFirst, FluidFirst };
 // Materials->Model.
-enum class ConstitutiveModel { MicropolarElastic };
+enum class ConstitutiveModel { MicropolarElastic, MicropolarDruckerPrager };
 // Fluid->Retention Model.
 enum class RetentionModel { Saturated, VanGenuchten };
 // Fracture->Bond Energy Force State.

@@ -140,9 +140,11 @@ KOKKOS_INLINE_FUNCTION double bond_kinematics(const X& x, const U& u, const T& t
 // Pass 1 (per owned point): eps, kappa (with K^-1 of the shape-tensor cache), the constitutive
 // update by `law` (sigma-bar, m into pts.stress, pts.couple_stress), Q1, Q2, and the point's
 // energy. Law: a pointwise micropolar law with
-//   KOKKOS_FUNCTION double stress<Dim>(const double* eps, const double* kappa, double* sigma,
-//                                      double* m) const   (returns the energy density W),
-// chosen once by the solver (include/mupm/laws/); MicropolarElastic is eqs 80-81.
+//   KOKKOS_FUNCTION double stress<Dim>(std::size_t i, const double* eps, const double* kappa,
+//                                      double* sigma, double* m) const
+// (returns the stored energy density W; i: the point, for a law with a state), chosen once by
+// the solver (include/mupm/laws/): MicropolarElastic is eqs 80-81, MicropolarDruckerPrager
+// eqs 80-95.
 template <int Dim, class Law>
 void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<Dim>& shape,
                  const SolidParams& prm, const Law& law, SolidState<Dim>& st) {
@@ -195,7 +197,7 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
           mat_mul<R, Dim>(B, Kinv, kap);
         }
         double sig[Dim * Dim], m[R * Dim];
-        double w = law.template stress<Dim>(eps, kap, sig, m);
+        double w = law.template stress<Dim>(i, eps, kap, sig, m);
         if (singular)
           w = 0;
         const double w0 = wsum * inv_vh;

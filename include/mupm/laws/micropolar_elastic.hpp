@@ -10,6 +10,7 @@
 namespace mupm {
 
 struct MicropolarElastic {
+  static constexpr bool plastic = false;
   double lambda = 0;  // Lame constant [Pa]
   double mu = 0;      // shear modulus [Pa]
   double mu_c = 0;    // micropolar (Cosserat) shear modulus [Pa]
@@ -47,6 +48,12 @@ struct MicropolarElastic {
       w += 0.5 * m[k] * kappa[k];
     }
     return w;
+  }
+  // The law of pass 1 (include/mupm/kernels/solid.hpp): the same at every point.
+  template <int Dim>
+  KOKKOS_INLINE_FUNCTION double stress(std::size_t /*i*/, const double* eps, const double* kappa,
+                                       double* sigma, double* m) const {
+    return stress<Dim>(eps, kappa, sigma, m);
   }
 };
 

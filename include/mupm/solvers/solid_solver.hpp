@@ -43,6 +43,14 @@ void solid_forces(Discretization<Dim>& disc, const SolidParams& prm, SolidState<
   solid_forces(disc, prm, prm.law, st);
 }
 
+// What the solid solver takes besides the law's parameters (the same for every law).
+struct SolidSettings {
+  double rho_s = 2000, rho_w = 1000;
+  Kokkos::Array<double, 3> gravity{};
+  double damping = 0;
+  FractureParams fracture;
+};
+
 // Law: the pointwise constitutive law of pass 1 (include/mupm/kernels/solid.hpp), chosen once
 // by the driver from Materials->Model.
 template <int Dim, class Law = MicropolarElastic>
@@ -50,15 +58,11 @@ class SolidSolver : public Mechanics {
  public:
   static constexpr int R = kRotDim<Dim>;
 
-  struct Settings {
-    double rho_s = 2000, rho_w = 1000;
-    Kokkos::Array<double, 3> gravity{};
-    double damping = 0;
-    FractureParams fracture;
-  };
+  using Settings = SolidSettings;
   struct Energy {
     double internal = 0, kinetic = 0, external_work = 0, dissipation = 0;
     double fracture = 0;     // strain energy lost when bonds broke (fracture dissipation)
+    double plastic = 0;      // plastic dissipation (Materials->Model = Micropolar Drucker-Prager)
     double bond_energy = 0;  // sum of W V_i V_j of the broken bonds (the criterion's energy)
     // Work of the pore water on the skeleton: sum over steps of sum_i V_i S_r p* d(tr eps_i)
     // (the -S_r p* 1 part of the total stress, eq 46; p* linear in tr eps within a step, so the
@@ -66,11 +70,11 @@ class SolidSolver : public Mechanics {
     double pore_work = 0;
     // E_int + E_kin + D - W_ext - W_pore, which the scheme keeps constant (eq 140).
     double balance() const {
-      return internal + kinetic + dissipation + fracture - external_work - pore_work;
+      return internal + kinetic + dissipation + fracture + plastic - external_work - pore_work;
     }
     double scale() const {
       return std::max(
-          std::max(std::max(std::abs(internal), kinetic), fracture),
+          std::max(std::max(std::abs(internal), kinetic), std::max(fracture, plastic)),
           std::max(std::max(std::abs(external_work), dissipation), std::abs(pore_work)));
     }
   };
@@ -133,6 +137,8 @@ class SolidSolver : public Mechanics {
       g("bond_energy_released", bond_energy_released_);
       g("broken_pairs", broken_pairs_);
     }
+    if constexpr (Law::plastic)
+      g("plastic_dissipation", plastic_dissipation_);
   }
   void series(SeriesRow& row) const override {
     const auto e = energy();
@@ -145,6 +151,8 @@ class SolidSolver : public Mechanics {
       row("fracture_energy", e.fracture);
       row("bond_energy_released", e.bond_energy);
     }
+    if constexpr (Law::plastic)
+      row("plastic_dissipation", e.plastic);
     row("energy_error", e.balance() - balance0_);
     const auto names = reaction_names();
     const auto values = reactions();
@@ -156,8 +164,8 @@ class SolidSolver : public Mechanics {
     const auto e = energy();
     EnergyBalance b;
     b.what = "solid";
-    b.expression = breaks() ? "E_int + E_kin + D + D_frac - W_ext - W_pore - E_0"
-                            : "E_int + E_kin + D - W_ext - W_pore - E_0";
+    b.expression = std::string("E_int + E_kin + D") + (breaks() ? " + D_frac" : "") +
+                   (Law::plastic ? " + D_plast" : "") + " - W_ext - W_pore - E_0";
     b.error = std::abs(e.balance() - balance0_);
     b.scale = e.scale();
     b.stored_expression = "E_int + E_kin";
@@ -220,6 +228,8 @@ class SolidSolver : public Mechanics {
   void step(double t, double dt) override {
     ScopedRegion region("mupm::Solid::step");
     auto& p = disc_.points;
+    if constexpr (Law::plastic)
+      commit_plastic();
     save_positions();
     advance_positions(p, dt);
     apply_kinematic(bcs_, p, t, dt);
@@ -257,6 +267,8 @@ class SolidSolver : public Mechanics {
       after_breakage(t + dt, w[5]);
       broken_pairs_ += w[3] / 2;
     }
+    if constexpr (Law::plastic)  // with the stress of the step's end, after any breakage
+      plastic_dissipation_ += plastic_power();
   }
   long long broken_pairs() const override { return (long long)broken_pairs_; }
 
@@ -366,6 +378,7 @@ class SolidSolver : public Mechanics {
     out.dissipation = dissipation_;
     out.pore_work = pore_work_;
     out.fracture = fracture_energy_;
+    out.plastic = plastic_dissipation_;
     out.bond_energy = bond_energy_released_;
     return out;
   }
@@ -465,7 +478,7 @@ class SolidSolver : public Mechanics {
         op, Dim + R, p.n_owned, p.gid, p.volume,
         [&] {
           disc_.dist.refresh({p.u, p.theta});
-          solid_forces(disc_, prm_, law_, st_);
+          solid_forces(disc_, prm_, prm_.law, st_);  // elastic: the stiffest tangent, no state
           if (crack)
             add_crack_force(st_.force);
         },
@@ -622,6 +635,31 @@ class SolidSolver : public Mechanics {
     return w;
   }
 
+  // The plastic law's current state becomes the start of the next step (the law's header).
+  void commit_plastic() {
+    auto& p = disc_.points;
+    const Law law = law_;
+    auto sig = p.stress, m = p.couple_stress;
+    Kokkos::parallel_for(
+        "mupm::Solid::plastic_commit", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i) { law.commit(i, sig, m); });
+  }
+  // Plastic dissipation of the step, summed over the ranks.
+  double plastic_power() const {
+    const auto& p = disc_.points;
+    const Law law = law_;
+    auto sig = p.stress, m = p.couple_stress, vol = p.volume;
+    double d = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::plastic_dissipation", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          acc += vol(i) * law.dissipation(i, sig, m);
+        },
+        d);
+    MPI_Allreduce(MPI_IN_PLACE, &d, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return d;
+  }
+
   void save_positions() {
     auto& p = disc_.points;
     auto u = p.u, th = p.theta, du = du_;
@@ -708,6 +746,7 @@ class SolidSolver : public Mechanics {
   Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
   double fracture_energy_ = 0;              // strain energy lost to bond breakage since t = 0 [J]
+  double plastic_dissipation_ = 0;          // plastic dissipation since t = 0 [J] (plastic law)
   double bond_energy_released_ = 0;         // W V_i V_j of the bonds broken since t = 0 [J]
   double broken_pairs_ = 0;                 // bond pairs broken since t = 0 (a restart global)
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
