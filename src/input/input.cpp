@@ -446,6 +446,12 @@ RCP<ParameterList> valid_parameters() {
               ". Global id and reference position are always written.",
           rcp(new Teuchos::ArrayStringValidator(one_of(output_field_names()))));
     o.set("Time Series Interval", 1, "Steps between rows of time_series.csv (>= 1).", at_least(1));
+    o.set("Second-Order Work Window", 0,
+          "Steps over which the second-order work (eq 42; field second_order_work, CSV "
+          "negative_second_order_work_fraction) takes its changes; 0: Field Interval. "
+          "Computed with Materials->Model = Micropolar Drucker-Prager or when Fields lists "
+          "second_order_work.",
+          at_least(0));
     o.set("Checkpoint Interval", 0, "Steps between checkpoints; 0: none during the run.",
           at_least(0));
     o.set("Checkpoint At End", true, "Write a checkpoint after the last step.");

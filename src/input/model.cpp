@@ -116,6 +116,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
   const auto fields = output.get<Array<std::string>>("Fields");
   r.fields.assign(fields.begin(), fields.end());
   r.field_interval = output.get<int>("Field Interval");
+  r.second_order_window = output.get<int>("Second-Order Work Window");
   r.series_interval = output.get<int>("Time Series Interval");
   r.checkpoint_interval = output.get<int>("Checkpoint Interval");
   r.checkpoint_at_end = output.get<bool>("Checkpoint At End");

@@ -5,6 +5,7 @@
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -233,6 +234,12 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
     settings.gravity = model.gravity;
     settings.damping = model.damping;
     settings.fracture = model.fracture;
+    const auto& f = model.run.fields;
+    if (model.constitutive_model == ConstitutiveModel::MicropolarDruckerPrager ||
+        std::find(f.begin(), f.end(), "second_order_work") != f.end())
+      settings.second_order_window = model.run.second_order_window > 0
+                                         ? model.run.second_order_window
+                                         : model.run.field_interval;
     auto attach = [&](auto solid) {
       if (auto* j = ph.j_integral.get()) {
         j->attach(solid->state(), solid->params());

@@ -129,6 +129,30 @@ TEST(DruckerPrager, SimpleShearAgainstClosedFormOneStepOrAThousand) {
   }
 }
 
+// Second-order work d2E = d sigma : d eps (eq 40) of a simple-shear increment: positive while
+// elastic, negative on the softening branch (tau falls as gamma grows, at the rate
+// mu (1 - 3 mu / (3 mu + 3 a1 a3 K + k h)) < 0 for h < 0), positive again at the residual
+// cohesion (perfect plasticity with dilatancy against the isochoric constraint hardens).
+TEST(DruckerPrager, SecondOrderWorkSignAlongSimpleShear) {
+  const auto el = soil();
+  const auto dp = example3();
+  const Consts k(dp);
+  const double gy = k.k * dp.cohesion / (std::sqrt(3.0) * el.mu);
+  auto d2 = [&](double g1, double g2) {
+    const double kap[2] = {0, 0};
+    const double e1[4] = {0, g1 / 2, g1 / 2, 0}, e2[4] = {0, g2 / 2, g2 / 2, 0};
+    const Out2 a = step2(el, dp, e1, kap, PlasticPoint<2>{});
+    const Out2 b = step2(el, dp, e2, kap, a.st);
+    double w = 0;
+    for (int c = 0; c < 4; ++c)
+      w += (b.sig[c] - a.sig[c]) * (e2[c] - e1[c]);
+    return w;
+  };
+  EXPECT_GT(d2(0.2 * gy, 0.6 * gy), 0);
+  EXPECT_LT(d2(1.5 * gy, 2.0 * gy), 0);
+  EXPECT_GT(d2(20 * gy, 21 * gy), 0);
+}
+
 // Curvature only (eps = 0): m = B kappa^e, q = sqrt(3/2) |m| / l,
 //   x = (q_t - k c0) / (3/4 mu + 3 a1 a3 K + k h), m = m_t q / q_t, q = q_t - 3/4 mu x.
 TEST(DruckerPrager, CurvatureOnlyAgainstClosedForm) {

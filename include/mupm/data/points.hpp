@@ -92,6 +92,8 @@ struct Points {
   Scalars cohesion;                   // c (eq 92)
   Scalars stress_zz;                  // sigma_zz of the plastic law (plane strain)
   Vectors plastic_step_start;         // the plastic state and stress at the step's start (law)
+  Scalars second_order_work;          // d2E of the last window [N/m^2] (eq 42)
+  Vectors second_order_work_start;    // sigma-bar, eps, m, kappa at the window's start
 
   // The registry: f(view, spec) for every field, in this order (the checkpoint's and the
   // output list's). Traits: kConstant (sent to the ghosts once), kGhosted (refreshed on the
@@ -203,6 +205,8 @@ struct Points {
     f(p.cohesion,          FieldSpec{"cohesion", 1, kState});
     f(p.stress_zz,         FieldSpec{"stress_zz", 1, kCheckpoint});
     f(p.plastic_step_start, FieldSpec{"plastic_step_start", 2 * D * D + 2 * R * D + 3, kCheckpoint});
+    f(p.second_order_work, FieldSpec{"second_order_work", 1, kState});
+    f(p.second_order_work_start, FieldSpec{"second_order_work_start", 2 * (D * D + R * D), kCheckpoint});
     // clang-format on
   }
 };

@@ -62,6 +62,7 @@ struct RunSettings {
   std::string folder = "output";
   std::vector<std::string> fields;
   int field_interval = 10, series_interval = 1, checkpoint_interval = 0;
+  int second_order_window = 0;  // 0: field_interval
   bool checkpoint_at_end = true;
   double progress_interval = 5;
   // Diagnostics.
@@ -75,8 +76,8 @@ struct Model {
   ConstitutiveModel constitutive_model = ConstitutiveModel::MicropolarElastic;
   SolidParams solid;
   DruckerPragerParams plasticity;  // Materials->Model = Micropolar Drucker-Prager
-  double solid_density = 2000;  // rho_s
-  double damping = 0;           // Solver->Damping
+  double solid_density = 2000;     // rho_s
+  double damping = 0;              // Solver->Damping
   FluidParams fluid;
   FractureParams fracture;
   JIntegralParams j_integral;          // no contours: no J

@@ -20,6 +20,7 @@
 #include "mupm/kernels/central_difference.hpp"
 #include "mupm/kernels/fracture.hpp"
 #include "mupm/kernels/fracture_flow.hpp"
+#include "mupm/kernels/shear_bands.hpp"
 #include "mupm/kernels/solid.hpp"
 #include "mupm/mesh/discretization.hpp"
 #include "mupm/solvers/module.hpp"
@@ -49,6 +50,9 @@ struct SolidSettings {
   Kokkos::Array<double, 3> gravity{};
   double damping = 0;
   FractureParams fracture;
+  // Steps per window of the second-order work (eq 42, include/mupm/kernels/shear_bands.hpp);
+  // 0: none.
+  int second_order_window = 0;
 };
 
 // Law: the pointwise constitutive law of pass 1 (include/mupm/kernels/solid.hpp), chosen once
@@ -139,6 +143,10 @@ class SolidSolver : public Mechanics {
     }
     if constexpr (Law::plastic)
       g("plastic_dissipation", plastic_dissipation_);
+    if (set_.second_order_window > 0) {
+      g("steps", steps_);
+      g("negative_second_order_work_fraction", negative_fraction_);
+    }
   }
   void series(SeriesRow& row) const override {
     const auto e = energy();
@@ -151,8 +159,15 @@ class SolidSolver : public Mechanics {
       row("fracture_energy", e.fracture);
       row("bond_energy_released", e.bond_energy);
     }
-    if constexpr (Law::plastic)
+    if constexpr (Law::plastic) {
       row("plastic_dissipation", e.plastic);
+      double angle, width;
+      bands(angle, width);
+      row("band_angle", angle);
+      row("band_width", width);
+    }
+    if (set_.second_order_window > 0)
+      row("negative_second_order_work_fraction", negative_fraction_);
     row("energy_error", e.balance() - balance0_);
     const auto names = reaction_names();
     const auto values = reactions();
@@ -216,6 +231,10 @@ class SolidSolver : public Mechanics {
     // fluid has updated since.
     if (restarted)  // the forces the run applied last, not those of the updated pressure
       restore_applied();
+    if (set_.second_order_window > 0 && !restarted)
+      second_order_work_start(p, st_.eps, st_.kappa, p.second_order_work_start);
+    if constexpr (Law::plastic)
+      find_centre();
     if (!restarted) {
       keep_applied();
       advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
@@ -269,6 +288,15 @@ class SolidSolver : public Mechanics {
     }
     if constexpr (Law::plastic)  // with the stress of the step's end, after any breakage
       plastic_dissipation_ += plastic_power();
+    steps_ += 1;
+    const int window = set_.second_order_window;
+    if (window > 0 && std::fmod(steps_, double(window)) == 0) {
+      second_order_work(p, st_.eps, st_.kappa, p.second_order_work_start, p.second_order_work);
+      double v[2];
+      negative_volume(p, p.second_order_work, v[0], v[1]);
+      MPI_Allreduce(MPI_IN_PLACE, v, 2, MPI_DOUBLE, MPI_SUM, comm_);
+      negative_fraction_ = v[0] > 0 ? v[1] / v[0] : 0.0;
+    }
   }
   long long broken_pairs() const override { return (long long)broken_pairs_; }
 
@@ -635,6 +663,43 @@ class SolidSolver : public Mechanics {
     return w;
   }
 
+  // The centre of the body's points (boundary layers excluded), for the band measurement.
+  void find_centre() {
+    auto& p = disc_.points;
+    auto x = p.x;
+    auto flags = p.flags;
+    double lo[2], hi[2];
+    for (int d = 0; d < 2; ++d) {
+      Kokkos::parallel_reduce(
+          "mupm::ShearBands::extent", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& a, double& b) {
+            if (flags(i) & kFlagBoundaryLayer)
+              return;
+            a = x(i, d) < a ? x(i, d) : a;
+            b = x(i, d) > b ? x(i, d) : b;
+          },
+          Kokkos::Min<double>(lo[d]), Kokkos::Max<double>(hi[d]));
+    }
+    MPI_Allreduce(MPI_IN_PLACE, lo, 2, MPI_DOUBLE, MPI_MIN, comm_);
+    MPI_Allreduce(MPI_IN_PLACE, hi, 2, MPI_DOUBLE, MPI_MAX, comm_);
+    for (int d = 0; d < 2; ++d)
+      centre_[d] = 0.5 * (lo[d] + hi[d]);
+  }
+  // band_angle [deg] and band_width [m] (include/mupm/kernels/shear_bands.hpp), collective.
+  void bands(double& angle, double& width) const {
+    const auto& p = disc_.points;
+    double mx = max_equivalent_plastic_strain(p);
+    MPI_Allreduce(MPI_IN_PLACE, &mx, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    BandMoments bm;
+    if (mx > 0) {
+      bm = band_moments(p, 0.5 * mx, centre_[0], centre_[1]);
+      MPI_Allreduce(MPI_IN_PLACE, &bm.b[0][0], 12, MPI_DOUBLE, MPI_SUM, comm_);
+      MPI_Allreduce(MPI_IN_PLACE, &bm.body_volume, 1, MPI_DOUBLE, MPI_SUM, comm_);
+      MPI_Allreduce(MPI_IN_PLACE, &bm.localized_volume, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    }
+    band_measure(bm, angle, width);
+  }
+
   // The plastic law's current state becomes the start of the next step (the law's header).
   void commit_plastic() {
     auto& p = disc_.points;
@@ -747,6 +812,9 @@ class SolidSolver : public Mechanics {
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
   double fracture_energy_ = 0;              // strain energy lost to bond breakage since t = 0 [J]
   double plastic_dissipation_ = 0;          // plastic dissipation since t = 0 [J] (plastic law)
+  double steps_ = 0;                        // steps since t = 0 (second-order work windows)
+  double negative_fraction_ = 0;            // volume fraction with d2E < 0, last window
+  double centre_[2] = {0, 0};               // centre of the body (band measurement)
   double bond_energy_released_ = 0;         // W V_i V_j of the bonds broken since t = 0 [J]
   double broken_pairs_ = 0;                 // bond pairs broken since t = 0 (a restart global)
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
