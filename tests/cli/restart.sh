@@ -6,7 +6,8 @@
 # 1 rank x 2 threads (fields and checkpoints compared byte for byte; for the crack, the broken
 # bonds too); the crack also by the J criterion (J and the broken bonds the same bits on 1 and 2
 # ranks), in a saturated, hydro-mechanical plate, and with water in the crack (fracture flow, both
-# crack-water force models), whose water balance is checked too.
+# crack-water force models), whose water balance is checked too; and a Drucker-Prager soil
+# restarted as its shear bands soften.
 source "$(dirname "$0")/common.sh"
 # make_input XML FOLDER STEPS RESTART [SED_EXPR]: the input (a path in the source tree) with
 # its folder, step count and restart file replaced, a field output every 20 steps, and SED_EXPR.
@@ -53,6 +54,10 @@ with h5py.File(f"{name}-straight/checkpoint.h5") as a, h5py.File(f"{name}-second
         broken = [float(rows[s]["broken_bonds"]) for s in (0, steps // 2, steps)]
         assert broken[0] < broken[1] < broken[2], broken
         print("restart %s: broken bonds %g -> %g (restart) -> %g" % (name, *broken))
+    if "plastic_dissipation" in rows[0]:  # plastic flow in both halves
+        dp = [float(rows[s]["plastic_dissipation"]) for s in (0, steps // 2, steps)]
+        assert dp[0] == 0 < dp[1] < dp[2], dp
+        print("restart %s: plastic dissipation %g -> %g (restart) -> %g J" % (name, *dp))
     if "j_integral" in rows[0]:  # J, a sum over ranks in global-id order: the same bits
         for part in ("first", "second"):  # 2 ranks, then 1 rank x 2 threads
             for r in csv.DictReader(open(f"{name}-{part}/time_series.csv")):
@@ -85,6 +90,10 @@ check fracture-hm tests/cli/fracture_small.xml 440 15 's|value="Micropolar Solid
 # A film of 0.1 mm keeps the crack water's stiffness K_w / a_min within the fixed 2 us step;
 # the injection is strong enough for the crack to grow before the restart.
 check fracture-flow tests/cli/fracture_small.xml 440 16 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|; s|<Parameter name="Bond Breakage"|<Parameter name="Fracture Flow" type="bool" value="true"/><Parameter name="Minimum Aperture" type="double" value="1e-4"/><Parameter name="Bond Breakage"|; s|<ParameterList name="Pre-Cracks">|<ParameterList name="Regions"><ParameterList name="mouth"><Parameter name="Min" type="Array(double)" value="{0, 0.045}"/><Parameter name="Max" type="Array(double)" value="{0.005, 0.055}"/></ParameterList></ParameterList><ParameterList name="Pre-Cracks">|; s|<ParameterList name="Boundary Conditions">|<ParameterList name="Boundary Conditions"><ParameterList name="mouth"><Parameter name="Type" type="string" value="Fracture Source"/><Parameter name="Region" type="string" value="mouth"/><Parameter name="Value" type="double" value="1e-2"/></ParameterList>|'
+# Drucker-Prager plasticity (Example 3 at 16 x 32, dt = 1.75e-5 s): restarted at step 3700
+# (t = 0.065 s), as the bands soften, with the plastic state, the step's start state and the
+# second-order work's window in the checkpoint.
+check plastic inputs/example3_biaxial.xml 7400 15 's|value="0.00166666666666667"/>|value="0.00625"/>|; s|value="\{60, 120\}"|value="{16, 32}"|; s|value="\{0.00166666666666667, 0.2\}"|value="{0.00625, 0.2}"|; s|value="\{0.0983333333333333, 0\}"|value="{0.09375, 0}"|; s|<Parameter name="Time Step" type="double" value="2.5e-6"/>|<Parameter name="Time Step" type="double" value="1.75e-5"/>|; s|<ParameterList name="Output">|<ParameterList name="Output"><Parameter name="Second-Order Work Window" type="int" value="100"/>|'
 # Water (bulk + fracture + injected) over the straight run, whose crack and network grow.
 "$PYTHON" - <<'PY'
 import csv

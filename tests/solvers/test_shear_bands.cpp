@@ -137,16 +137,16 @@ TEST(SecondOrderWork, HomogeneousDeformationGivesSigmaColonEps) {
     EXPECT_NEAR(got(i), w, 1e-8 * w) << i;
 }
 
-// Band measurement on synthetic conjugate bands: points within w/2 of the lines through the
-// centre at +-beta from the horizontal get eps-hat = 1, the others 0.1: band_angle = beta and
-// band_width = w to a spacing.
+// Band measurement on synthetic conjugate bands crossing off the body's centre: points within
+// w/2 of the lines through (cx, cy) at +-beta from the horizontal get eps-hat = 1, the others
+// 0.1: band_angle = beta and band_width = w to a spacing.
 TEST(ShearBands, SyntheticConjugateBands) {
   const double dx = 1e-3, beta = 57.5 * kPi / 180, w = 6e-3;
   Discretization<2> disc = discretize(test::world(), test::box<2>({100, 200}, 3.05, dx));
   auto& p = disc.points;
   auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), p.x);
   auto e = Kokkos::create_mirror_view(p.equivalent_plastic_strain);
-  const double cx = 0.05, cy = 0.1;
+  const double cx = 0.05, cy = 0.115;  // the body's centre is (0.05, 0.1)
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double dxp = x(i, 0) - cx, dyp = x(i, 1) - cy;
     const double d1 = std::fabs(-std::sin(beta) * dxp + std::cos(beta) * dyp);
@@ -154,25 +154,23 @@ TEST(ShearBands, SyntheticConjugateBands) {
     e(i) = (std::min(d1, d2) < w / 2 && std::fabs(dyp) < 0.07) ? 1.0 : 0.1;
   }
   Kokkos::deep_copy(p.equivalent_plastic_strain, e);
-  double mx = max_equivalent_plastic_strain(p);
-  MPI_Allreduce(MPI_IN_PLACE, &mx, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  BandMoments bm = band_moments(p, 0.5 * mx, cx, cy);
-  MPI_Allreduce(MPI_IN_PLACE, &bm.b[0][0], 12, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  MPI_Allreduce(MPI_IN_PLACE, &bm.body_volume, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  MPI_Allreduce(MPI_IN_PLACE, &bm.localized_volume, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  auto sum = [](double* d, int n) {
+    MPI_Allreduce(MPI_IN_PLACE, d, n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  };
+  auto max = [](double* d, int n) {
+    MPI_Allreduce(MPI_IN_PLACE, d, n, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  };
   double angle, width;
-  band_measure(bm, angle, width);
+  measure_bands(p, 0.05, 0.1, sum, max, angle, width);
   EXPECT_NEAR(angle, 57.5, 1.0);
   EXPECT_NEAR(width, w, dx);
-  // Nothing localized (uniform yielding): 0.
-  Kokkos::deep_copy(p.equivalent_plastic_strain, 1.0);
-  bm = band_moments(p, 0.5, cx, cy);
-  MPI_Allreduce(MPI_IN_PLACE, &bm.b[0][0], 12, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  MPI_Allreduce(MPI_IN_PLACE, &bm.body_volume, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  MPI_Allreduce(MPI_IN_PLACE, &bm.localized_volume, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  band_measure(bm, angle, width);
-  EXPECT_EQ(angle, 0.0);
-  EXPECT_EQ(width, 0.0);
+  // Uniform yielding (nothing localized), and no yielding: 0.
+  for (double v : {1.0, 0.0}) {
+    Kokkos::deep_copy(p.equivalent_plastic_strain, v);
+    measure_bands(p, 0.05, 0.1, sum, max, angle, width);
+    EXPECT_EQ(angle, 0.0);
+    EXPECT_EQ(width, 0.0);
+  }
 }
 
 }  // namespace

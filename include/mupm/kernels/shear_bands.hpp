@@ -16,8 +16,9 @@
 //
 // Band measurement (Example 3): the localized points are those with an equivalent plastic
 // strain of at least half the largest one (and above zero). They are split into the two
-// branches of a conjugate pair through the specimen's centre c: branch + where
-// (x - c_x)(y - c_y) > 0 (a band rising to the right), branch - where < 0. Each branch gets the
+// branches of a conjugate pair through their own centroid c (the crossing of an X, wherever it
+// nucleated): branch + where (x - c_x)(y - c_y) > 0 (a band rising to the right), branch -
+// where < 0. Each branch gets the
 // principal axis of its points' second moments (a total least-squares line through their
 // centroid): its angle from the horizontal, in [0, 90] degrees, and its width sqrt(12) times the
 // standard deviation across the axis (the width of a uniform band with that spread). band_angle
@@ -101,6 +102,7 @@ void negative_volume(const Points<Dim>& pts, const Scalars& d2, double& total, d
 // the localized points (coordinates relative to c), and the body's and the localized volume.
 struct BandMoments {
   double b[2][6] = {};
+  double all[6] = {};  // the same over all localized points
   double body_volume = 0, localized_volume = 0;
 };
 
@@ -127,7 +129,7 @@ BandMoments band_moments(const Points<Dim>& pts, double threshold, double cx, do
   auto vol = pts.volume;
   auto flags = pts.flags;
   BandMoments out;
-  for (int br = 0; br < 2; ++br) {
+  for (int br = 0; br < 3; ++br) {  // 2: all localized points (c = 0: their centroid)
     const double sign = br == 0 ? 1.0 : -1.0;
     double s[6] = {};
     Kokkos::parallel_reduce(
@@ -137,7 +139,7 @@ BandMoments band_moments(const Points<Dim>& pts, double threshold, double cx, do
           if ((flags(i) & kFlagBoundaryLayer) || !(e(i) >= threshold))
             return;
           const double dx = x(i, 0) - cx, dy = x(i, 1) - cy;
-          if (!(sign * dx * dy > 0))
+          if (br < 2 && !(sign * dx * dy > 0))
             return;
           n += 1;
           sx += dx;
@@ -148,7 +150,7 @@ BandMoments band_moments(const Points<Dim>& pts, double threshold, double cx, do
         },
         s[0], s[1], s[2], s[3], s[4], s[5]);
     for (int k = 0; k < 6; ++k)
-      out.b[br][k] = s[k];
+      (br < 2 ? out.b[br][k] : out.all[k]) = s[k];
   }
   double t = 0, l = 0;
   Kokkos::parallel_reduce(
@@ -194,6 +196,27 @@ inline void band_measure(const BandMoments& bm, double& angle, double& width) {
     angle /= used;
     width /= used;
   }
+}
+
+// The whole measurement over the ranks: sum(data, n) and max(data, n) reduce in place over
+// them (the caller's MPI; identity on one rank). cx, cy: the body's centre.
+template <int Dim, class Sum, class Max>
+void measure_bands(const Points<Dim>& pts, double cx, double cy, const Sum& sum, const Max& max,
+                   double& angle, double& width) {
+  double mx = max_equivalent_plastic_strain(pts);
+  max(&mx, 1);
+  BandMoments bm;
+  if (mx > 0) {
+    // The localized points' centroid first, then the branches through it.
+    bm = band_moments(pts, 0.5 * mx, cx, cy);
+    sum(bm.all, 6);
+    const double n = bm.all[0] > 0 ? bm.all[0] : 1;
+    bm = band_moments(pts, 0.5 * mx, cx + bm.all[1] / n, cy + bm.all[2] / n);
+    sum(&bm.b[0][0], 12);
+    sum(&bm.body_volume, 1);
+    sum(&bm.localized_volume, 1);
+  }
+  band_measure(bm, angle, width);
 }
 
 }  // namespace mupm

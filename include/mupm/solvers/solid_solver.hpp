@@ -687,17 +687,13 @@ class SolidSolver : public Mechanics {
   }
   // band_angle [deg] and band_width [m] (include/mupm/kernels/shear_bands.hpp), collective.
   void bands(double& angle, double& width) const {
-    const auto& p = disc_.points;
-    double mx = max_equivalent_plastic_strain(p);
-    MPI_Allreduce(MPI_IN_PLACE, &mx, 1, MPI_DOUBLE, MPI_MAX, comm_);
-    BandMoments bm;
-    if (mx > 0) {
-      bm = band_moments(p, 0.5 * mx, centre_[0], centre_[1]);
-      MPI_Allreduce(MPI_IN_PLACE, &bm.b[0][0], 12, MPI_DOUBLE, MPI_SUM, comm_);
-      MPI_Allreduce(MPI_IN_PLACE, &bm.body_volume, 1, MPI_DOUBLE, MPI_SUM, comm_);
-      MPI_Allreduce(MPI_IN_PLACE, &bm.localized_volume, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    }
-    band_measure(bm, angle, width);
+    auto sum = [this](double* d, int n) {
+      MPI_Allreduce(MPI_IN_PLACE, d, n, MPI_DOUBLE, MPI_SUM, comm_);
+    };
+    auto max = [this](double* d, int n) {
+      MPI_Allreduce(MPI_IN_PLACE, d, n, MPI_DOUBLE, MPI_MAX, comm_);
+    };
+    measure_bands(disc_.points, centre_[0], centre_[1], sum, max, angle, width);
   }
 
   // The plastic law's current state becomes the start of the next step (the law's header).
