@@ -1,9 +1,10 @@
 // Google Benchmark of the micropolar correspondence kernels on one rank: pass 1 (K, eps, kappa,
 // constitutive update, stabilization Q1/Q2 and energy), pass 2 (force and moment densities) and
 // the whole force evaluation (solid_forces: pass 1, ghost refresh, pass 2), in 2D (400 x 400)
-// and 3D (50^3) at delta = 3.015 dx and 4.015 dx; and what bond breakage adds to a step: the
-// force evaluation with the bond-energy accumulation, the breakage scan, the damage update.
-// Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads ./perf/bench_solid
+// and 3D (50^3) at delta = 3.015 dx and 4.015 dx, pass 1 also with the Drucker-Prager law; and what
+// bond breakage adds to a step: the force evaluation with the bond-energy accumulation, the
+// breakage scan, the damage update. Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads
+// ./perf/bench_solid
 #include <cmath>
 
 #include "bench_common.hpp"
@@ -75,6 +76,31 @@ void BM_SolidPass1(benchmark::State& state) {
   set_counters(state, b);
 }
 
+// Pass 1 with Micropolar Drucker-Prager (eqs 82-95), every point plastic (c0 = 10 Pa against
+// stresses of kPa, the Example 3 angles and softening): the return-mapping's worst case, to set
+// against BM_SolidPass1 (the elastic law).
+template <int Dim>
+void BM_SolidPass1Plastic(benchmark::State& state) {
+  auto& b = body<Dim>(state);
+  DruckerPragerParams dp;
+  dp.friction = dp.dilation = 35 * kPi / 180;
+  dp.cohesion = 10;
+  dp.residual = 2.5;
+  dp.softening = -1e7;
+  const MicropolarDruckerPrager<Dim> law(b.prm.law, dp, b.disc.points);
+  for (auto _ : state) {
+    solid_pass1(b.disc.points, b.disc.bonds, b.disc.shape, b.prm, law, b.st);
+    Kokkos::fence();
+  }
+  double plastic = 0;
+  auto eq = b.disc.points.equivalent_plastic_strain;
+  Kokkos::parallel_reduce(
+      "bench::plastic_points", range(0, b.disc.points.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i, double& acc) { acc += eq(i) > 0 ? 1.0 : 0.0; }, plastic);
+  state.counters["plastic_fraction"] = plastic / double(b.disc.points.n_owned);
+  set_counters(state, b);
+}
+
 template <int Dim>
 void BM_SolidPass2(benchmark::State& state) {
   auto& b = body<Dim>(state);
@@ -139,6 +165,10 @@ void BM_SolidForcesWithBreakage(benchmark::State& state) {
 // to T times too high.
 #define MUPM_SOLID_BENCH(Dim, n, factor)              \
   BENCHMARK_TEMPLATE(BM_SolidPass1, Dim)              \
+      ->Args({n, factor})                             \
+      ->Unit(benchmark::kMillisecond)                 \
+      ->UseRealTime();                                \
+  BENCHMARK_TEMPLATE(BM_SolidPass1Plastic, Dim)       \
       ->Args({n, factor})                             \
       ->Unit(benchmark::kMillisecond)                 \
       ->UseRealTime();                                \
