@@ -236,6 +236,11 @@ base "$crack" '' | jlist '' |
 expect j_no_contour 2 'mupm->Fracture->Bond Breakage' 'mupm->J-Integral->Half Widths'
 base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3, 4}"/><Parameter name="Half Heights" type="Array(double)" value="{3}"/>' >j_sizes.xml
 expect j_sizes 2 'mupm->J-Integral->Half Heights' 'one per contour'
+# Drucker-Prager: no cohesion, a residual cohesion above the initial one.
+base '' '' | sed 's|<Parameter name="Bulk Modulus"|<Parameter name="Model" type="string" value="Micropolar Drucker-Prager"/>&|' >dp_no_cohesion.xml
+expect dp_no_cohesion 2 'mupm->Materials->Cohesion' 'must be > 0'
+base '' '' | sed 's|<Parameter name="Bulk Modulus"|<Parameter name="Model" type="string" value="Micropolar Drucker-Prager"/><Parameter name="Cohesion" type="double" value="1e5"/><Parameter name="Residual Cohesion" type="double" value="2e5"/>&|' >dp_residual.xml
+expect dp_residual 2 'mupm->Materials->Residual Cohesion' 'exceeds'
 # A grid beyond the machine's memory is refused before anything is allocated, by the run and by
 # --validate (it once grew until the kernel killed it, or ended in std::bad_alloc).
 base '' '' | sed 's|value="{20, 10}"|value="{20000, 20000}"|' >huge.xml
