@@ -7,10 +7,10 @@
       columns of time_series.csv against time.
   mupm_plot.py compare COLUMN OUTPUT_DIR[:LABEL] [OUTPUT_DIR[:LABEL] ...] [--time-scale S]
                        [--x-column X] [--xlabel TEXT] [--reference X Y [X Y ...]]
-                       [--reference-label TEXT] [-o out.png]
-      one column of several runs against time x S (e.g. the load of a ramp), or against another
-      column x S (--x-column, e.g. crack_length with S = 1/W for a/W), with reference points
-      (X, Y) such as a paper's values.
+                       [--reference-label TEXT] [--scale Y] [--ylabel TEXT] [-o out.png]
+      one column of several runs (x Y, e.g. -1e-3 for a compressive reaction in kN) against
+      time x S (e.g. the load of a ramp), or against another column x S (--x-column, e.g.
+      crack_length with S = 1/W for a/W), with reference points (X, Y) such as a paper's values.
 """
 import argparse
 import csv
@@ -85,13 +85,13 @@ def plot_compare(args):
         if args.x_column and args.x_column not in rows[0]:
             raise SystemExit("%s: no column %s in time_series.csv" % (d, args.x_column))
         ax.plot([float(r[args.x_column or "time"]) * args.time_scale for r in rows],
-                [float(r[args.column]) for r in rows], label=label or d)
+                [float(r[args.column]) * args.scale for r in rows], label=label or d)
     if args.reference:
         if len(args.reference) % 2:
             raise SystemExit("--reference takes pairs X Y")
         ax.plot(args.reference[0::2], args.reference[1::2], "ko", label=args.reference_label)
     ax.set_xlabel(args.xlabel)
-    ax.set_ylabel(args.column)
+    ax.set_ylabel(args.ylabel or args.column)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.savefig(args.output, dpi=150, bbox_inches="tight")
@@ -118,6 +118,8 @@ def main():
     c.add_argument("--time-scale", type=float, default=1.0)
     c.add_argument("--x-column", default="")
     c.add_argument("--xlabel", default="time [s]")
+    c.add_argument("--scale", type=float, default=1.0, help="multiplies the column (e.g. -1e-3)")
+    c.add_argument("--ylabel", default="")
     c.add_argument("--reference", type=float, nargs="+")
     c.add_argument("--reference-label", default="reference")
     c.add_argument("-o", "--output", default="compare.png")
