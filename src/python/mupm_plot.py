@@ -8,7 +8,7 @@
   mupm_plot.py compare COLUMN OUTPUT_DIR[:LABEL] [OUTPUT_DIR[:LABEL] ...] [--time-scale S]
                        [--x-column X] [--xlabel TEXT] [--reference X Y [X Y ...]]
                        [--reference-label TEXT] [--scale Y] [--ylabel TEXT] [-o out.png]
-      one column of several runs (x Y, e.g. -1e-3 for a compressive reaction in kN) against
+      one column of several runs (x Y, e.g. --scale=-1e-3 for a compressive reaction in kN) against
       time x S (e.g. the load of a ramp), or against another column x S (--x-column, e.g.
       crack_length with S = 1/W for a/W), with reference points (X, Y) such as a paper's values.
 """
