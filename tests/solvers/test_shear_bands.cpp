@@ -83,7 +83,7 @@ TEST(SecondOrderWork, PointFieldIsTheBondSumOfEq42) {
   });
   b.forces();
   const Snapshot A = snapshot(b);
-  second_order_work_start(p, b.st.eps, b.st.kappa, start);
+  second_order_work(p, b.st.eps, b.st.kappa, start, Scalars());
   b.set([](const double* x, double* u, double* t) {
     u[0] = 3e-4 * std::sin(25 * x[0]) * std::cos(20 * x[1]);
     u[1] = -1e-4 * std::sin(60 * x[0] * x[1] + 1);
@@ -115,7 +115,7 @@ TEST(SecondOrderWork, HomogeneousDeformationGivesSigmaColonEps) {
   Vectors start("start", p.size(), 12);
   Scalars d2("d2", p.size());
   b.forces();  // at rest
-  second_order_work_start(p, b.st.eps, b.st.kappa, start);
+  second_order_work(p, b.st.eps, b.st.kappa, start, Scalars());
   const double A[4] = {1e-3, -4e-4, 7e-4, -2e-3}, th = 3e-4;
   b.set([&](const double* x, double* u, double* t) {
     u[0] = A[0] * x[0] + A[1] * x[1];

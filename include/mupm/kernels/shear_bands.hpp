@@ -35,13 +35,15 @@
 
 namespace mupm {
 
-// d2E of the window ending now (eq 40 = eq 42, header) into out, and the window's start <- now.
+// d2E of the window ending now (eq 40 = eq 42, header) into out (none if out is empty: the first
+// window's start), and the window's start <- now.
 // start: [n][2 (Dim*Dim + RotDim*Dim)]: sigma-bar, eps, m, kappa.
 template <int Dim>
 void second_order_work(const Points<Dim>& pts, const Vectors& eps, const Vectors& kappa,
                        const Vectors& start, const Scalars& out) {
   constexpr int R = kRotDim<Dim>, S = Dim * Dim, C = R * Dim;
   auto sig = pts.stress, m = pts.couple_stress;
+  const bool write = out.extent(0) > 0;
   Kokkos::parallel_for(
       "mupm::ShearBands::second_order_work", range(0, pts.n_owned),
       KOKKOS_LAMBDA(const std::size_t i) {
@@ -56,27 +58,8 @@ void second_order_work(const Points<Dim>& pts, const Vectors& eps, const Vectors
           start(i, 2 * S + k) = m(i, k);
           start(i, 2 * S + C + k) = kappa(i, k);
         }
-        out(i) = w;
-      });
-}
-
-// The window's start <- now, without a d2E (the first window).
-template <int Dim>
-void second_order_work_start(const Points<Dim>& pts, const Vectors& eps, const Vectors& kappa,
-                             const Vectors& start) {
-  constexpr int R = kRotDim<Dim>, S = Dim * Dim, C = R * Dim;
-  auto sig = pts.stress, m = pts.couple_stress;
-  Kokkos::parallel_for(
-      "mupm::ShearBands::second_order_start", range(0, pts.n_owned),
-      KOKKOS_LAMBDA(const std::size_t i) {
-        for (int k = 0; k < S; ++k) {
-          start(i, k) = sig(i, k);
-          start(i, S + k) = eps(i, k);
-        }
-        for (int k = 0; k < C; ++k) {
-          start(i, 2 * S + k) = m(i, k);
-          start(i, 2 * S + C + k) = kappa(i, k);
-        }
+        if (write)
+          out(i) = w;
       });
 }
 

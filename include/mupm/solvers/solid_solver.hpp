@@ -232,9 +232,7 @@ class SolidSolver : public Mechanics {
     if (restarted)  // the forces the run applied last, not those of the updated pressure
       restore_applied();
     if (set_.second_order_window > 0 && !restarted)
-      second_order_work_start(p, st_.eps, st_.kappa, p.second_order_work_start);
-    if constexpr (Law::plastic)
-      find_centre();
+      second_order_work(p, st_.eps, st_.kappa, p.second_order_work_start, Scalars());
     if (!restarted) {
       keep_applied();
       advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
@@ -663,28 +661,6 @@ class SolidSolver : public Mechanics {
     return w;
   }
 
-  // The centre of the body's points (boundary layers excluded), for the band measurement.
-  void find_centre() {
-    auto& p = disc_.points;
-    auto x = p.x;
-    auto flags = p.flags;
-    double lo[2], hi[2];
-    for (int d = 0; d < 2; ++d) {
-      Kokkos::parallel_reduce(
-          "mupm::ShearBands::extent", range(0, p.n_owned),
-          KOKKOS_LAMBDA(const std::size_t i, double& a, double& b) {
-            if (flags(i) & kFlagBoundaryLayer)
-              return;
-            a = x(i, d) < a ? x(i, d) : a;
-            b = x(i, d) > b ? x(i, d) : b;
-          },
-          Kokkos::Min<double>(lo[d]), Kokkos::Max<double>(hi[d]));
-    }
-    MPI_Allreduce(MPI_IN_PLACE, lo, 2, MPI_DOUBLE, MPI_MIN, comm_);
-    MPI_Allreduce(MPI_IN_PLACE, hi, 2, MPI_DOUBLE, MPI_MAX, comm_);
-    for (int d = 0; d < 2; ++d)
-      centre_[d] = 0.5 * (lo[d] + hi[d]);
-  }
   // band_angle [deg] and band_width [m] (include/mupm/kernels/shear_bands.hpp), collective.
   void bands(double& angle, double& width) const {
     auto sum = [this](double* d, int n) {
@@ -693,7 +669,9 @@ class SolidSolver : public Mechanics {
     auto max = [this](double* d, int n) {
       MPI_Allreduce(MPI_IN_PLACE, d, n, MPI_DOUBLE, MPI_MAX, comm_);
     };
-    measure_bands(disc_.points, centre_[0], centre_[1], sum, max, angle, width);
+    const auto& g = disc_.grid;  // the real body's centre
+    measure_bands(disc_.points, g.origin[0] + 0.5 * g.counts[0] * g.dx,
+                  g.origin[1] + 0.5 * g.counts[1] * g.dx, sum, max, angle, width);
   }
 
   // The plastic law's current state becomes the start of the next step (the law's header).
@@ -810,7 +788,6 @@ class SolidSolver : public Mechanics {
   double plastic_dissipation_ = 0;          // plastic dissipation since t = 0 [J] (plastic law)
   double steps_ = 0;                        // steps since t = 0 (second-order work windows)
   double negative_fraction_ = 0;            // volume fraction with d2E < 0, last window
-  double centre_[2] = {0, 0};               // centre of the body (band measurement)
   double bond_energy_released_ = 0;         // W V_i V_j of the bonds broken since t = 0 [J]
   double broken_pairs_ = 0;                 // bond pairs broken since t = 0 (a restart global)
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
