@@ -135,6 +135,13 @@ void bc_template(ParameterList& c) {
   c.set("Ramp Time", 0.0, "Ramp duration [s] (Time Function = Ramp).", at_least(0.0));
   c.set("Times", Array<double>(), "Table times [s], increasing (Time Function = Table).");
   c.set("Values", Array<double>(), "Table values (Time Function = Table), as many as Times.");
+  c.set("Boundary Layer Values", std::string("Default"),
+        "Pore Pressure on boundary-layer points: Constant (the prescribed value g, the paper's "
+        "method) or Mirrored (2 g - p of the body point mirrored about the face, so that p "
+        "passes through g at the face); Default: Discretization->Boundary Layer Values. Points "
+        "of the region that are not layer points hold g either way. Displacement, Velocity and "
+        "Micro-Rotation are Constant only (README, 'Boundary layers').",
+        one_of({"Default", "Constant", "Mirrored"}));
 }
 
 // The user-named sublists: validated against their template one by one, not by Teuchos'
@@ -187,6 +194,15 @@ RCP<ParameterList> valid_parameters() {
           "paper's boundary-layer method), any of -x +x -y +y -z +z. "
           "Each layer is also a region named 'Layer -y' etc.",
           rcp(new Teuchos::ArrayStringValidator(one_of(kFaces))));
+    d.set("Boundary Layer Values", std::string("Constant"),
+          "How Pore Pressure conditions set their boundary-layer points, unless a condition's "
+          "own Boundary Layer Values says otherwise. Constant: the prescribed value g (the "
+          "paper's method; the face then drains as if it sat about 0.7 delta farther out). "
+          "Mirrored: a layer point at distance d outside the face takes 2 g - p(m), p(m) the "
+          "pressure of the point m at distance d inside, every fluid substep (the face: the one "
+          "the condition's region lies outside of). Kinematic conditions stay Constant. See "
+          "README, 'Boundary layers'.",
+          one_of({"Constant", "Mirrored"}));
     ParameterList& r = d.sublist("Regions", false,
                                  "Named boxes for boundary and initial conditions and outputs: "
                                  "one sublist per region, named as you like (at most 24).");
@@ -764,6 +780,16 @@ void check_dimension_arrays(ParameterList& input) {
       throw InputError("Error, " + path_of(c, "Component") + " = " + comp + ": a " +
                        std::to_string(dim) + "D body has components x" +
                        (dim == 3 ? ", y and z." : " and y."));
+    // Mirrored kinematic layers were built and measured unstable (the odd reflection of every
+    // component of a held face is not an invariant subspace of the vector operator: Terzaghi's
+    // column grew without bound at H = 40 dx), so they are refused rather than run.
+    if (c.get<std::string>("Boundary Layer Values") == "Mirrored" &&
+        type != BoundaryCondition::PorePressure)
+      throw InputError("Error, " + path_of(c, "Boundary Layer Values") +
+                       " = Mirrored: only Pore Pressure conditions mirror their boundary-layer "
+                       "values; " +
+                       c.get<std::string>("Type") +
+                       " conditions hold the prescribed value (write Constant or Default).");
     const auto tf = time_function_options()(c.get<std::string>("Time Function"));
     if (tf == TimeFunction::Ramp && !(c.get<double>("Ramp Time") > 0))
       throw InputError("Error, " + path_of(c, "Ramp Time") + " must be > 0 for a Ramp.");
@@ -1275,6 +1301,10 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterLis
     const auto t = c.get<Array<double>>("Times"), v = c.get<Array<double>>("Values");
     bc.time.times.assign(t.begin(), t.end());
     bc.time.values.assign(v.begin(), v.end());
+    std::string values = c.get<std::string>("Boundary Layer Values");
+    if (values == "Default")
+      values = input.sublist("Discretization").get<std::string>("Boundary Layer Values");
+    bc.mirrored = bc.kind == BoundaryCondition::PorePressure && values == "Mirrored";
     out.push_back(bc);
   }
   return out;

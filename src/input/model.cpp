@@ -205,6 +205,8 @@ Model<Dim> model_from_input(const ParameterList& input) {
     m.j_integral.max_speed = std::sqrt(m.solid.law.mu / rho) * (0.862 + 1.14 * nu) / (1 + nu);
 
   m.boundary_conditions = boundary_conditions_from_input(input);
+  for (const auto& bc : m.boundary_conditions)
+    m.grid.mirrored_layers = m.grid.mirrored_layers || bc.mirrored;
   m.initial_conditions = initial_conditions_from_input(input);
   return m;
 }

@@ -163,6 +163,17 @@ cat >>empty_region.xml <<'XML'
 </ParameterList>
 XML
 expect empty_region 2 "mupm->Boundary Conditions->pull->Region = 'outside' holds no point"
+# Mirrored boundary-layer values are for Pore Pressure conditions only.
+base '<Parameter name="Boundary Layers" type="Array(string)" value="{-x}"/>' '' | sed '$d' >mirrored_kinematic.xml
+cat >>mirrored_kinematic.xml <<'XML'
+  <ParameterList name="Boundary Conditions"><ParameterList name="hold">
+    <Parameter name="Type" type="string" value="Displacement"/>
+    <Parameter name="Region" type="string" value="Layer -x"/>
+    <Parameter name="Boundary Layer Values" type="string" value="Mirrored"/>
+  </ParameterList></ParameterList>
+</ParameterList>
+XML
+expect mirrored_kinematic 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'only Pore Pressure'
 base '' '' | sed 's|value="out"|value="done"|' >done.xml
 run 2 1 done.xml >done.out 2>&1 || { cat done.out; fail "done.xml did not run"; }
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |

@@ -55,6 +55,61 @@ TEST(Distribution, GhostsEqualOwners2D) {
   check_ghosts(g);
 }
 
+// The mirrors of the boundary-layer points (Boundary Layer Values = Mirrored): column d of
+// Discretization::mirror holds, for a point outside the face of axis d, the point reflected
+// across that face (x_m = 2 face - x on axis d, the rest unchanged; layers thicker than the body
+// clamp into it) and column Dim the same for points outside one face only. The body is 4 points
+// across x with 3-row layers, so on 2 ranks the cut falls within the layers' reach and some
+// mirrors are ghosts beyond the horizon.
+template <int Dim>
+void check_mirrors(GridSpec<Dim> g) {
+  g.mirrored_layers = true;
+  auto disc = discretize(test::world(), g);
+  const auto& pts = disc.points;
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
+  auto m = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.mirror);
+  ASSERT_EQ(m.extent(0), pts.n_owned);
+  long long checked = 0;
+  for (std::size_t i = 0; i < pts.n_owned; ++i) {
+    int outside = 0;
+    for (int d = 0; d < Dim; ++d) {
+      const double lo = g.origin[d], hi = lo + g.counts[d] * g.dx;
+      const bool out = x(i, d) < lo || x(i, d) > hi;
+      outside += out;
+      ASSERT_EQ(m(i, d) >= 0, out) << "point " << i << " axis " << d;
+      if (!out)
+        continue;
+      double want = x(i, d) < lo ? 2 * lo - x(i, d) : 2 * hi - x(i, d);
+      want = std::min(std::max(want, lo + 0.5 * g.dx), hi - 0.5 * g.dx);  // clamped
+      for (int e = 0; e < Dim; ++e)
+        ASSERT_NEAR(x(m(i, d), e), e == d ? want : x(i, e), 1e-12) << "point " << i;
+      ++checked;
+    }
+    ASSERT_EQ(m(i, Dim), outside == 1 ? [&] {
+      for (int d = 0; d < Dim; ++d)
+        if (m(i, d) >= 0)
+          return m(i, d);
+      return -1;
+    }()
+                                      : -1);
+  }
+  long long total = 0;
+  MPI_Allreduce(&checked, &total, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_GT(total, 0);
+}
+
+TEST(Distribution, LayerMirrors2D) {
+  auto g = test::box<2>({4, 5}, 1.5);
+  g.layers = {{{3, 3}, {2, 2}}};
+  check_mirrors(g);
+}
+
+TEST(Distribution, LayerMirrors3D) {
+  auto g = test::box<3>({4, 3, 3}, 1.5);
+  g.layers = {{{3, 3}, {2, 0}, {0, 2}}};
+  check_mirrors(g);
+}
+
 TEST(Distribution, GhostsEqualOwners3D) {
   check_ghosts(test::box<3>({8, 7, 9}, 3.015));
 }

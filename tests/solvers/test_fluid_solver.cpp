@@ -358,8 +358,9 @@ struct ColumnRun {
   double dt = 0;
   long long step = 0;
 
-  ColumnRun(const Terzaghi& tz, int rows_h, bool fluid_first, double dt_factor, bool damped = true)
-      : disc(discretize(test::world(), column_grid(tz, rows_h))) {
+  ColumnRun(const Terzaghi& tz, int rows_h, bool fluid_first, double dt_factor, bool damped = true,
+            bool mirrored = false)
+      : disc(discretize(test::world(), column_grid(tz, rows_h, mirrored))) {
     const auto& g = disc.grid;
     Kokkos::deep_copy(disc.points.porosity, tz.phi);
     Kokkos::deep_copy(disc.points.saturation, 1.0);
@@ -383,6 +384,8 @@ struct ColumnRun {
     bcs.back().time.ramp_time = tz.t_r;
     add("drain_base", BoundaryCondition::PorePressure, 2, 0, 0.0);
     add("drain_top", BoundaryCondition::PorePressure, 3, 0, 0.0);
+    for (auto& bc : bcs)
+      bc.mirrored = mirrored && bc.kind == BoundaryCondition::PorePressure;
     const SolidParams sp = solid_params(tz.law, g, 0.5);
     SolidSolver<2>::Settings set;
     set.rho_s = tz.rho_s;
@@ -402,8 +405,9 @@ struct ColumnRun {
     stagger = {solid.get(), fluid.get(), nullptr,
                fluid_first, 1,           std::max(1, int(std::ceil(dt / dt_f)))};
   }
-  static GridSpec<2> column_grid(const Terzaghi& tz, int rows_h) {
+  static GridSpec<2> column_grid(const Terzaghi& tz, int rows_h, bool mirrored) {
     auto g = test::box<2>({6, 2 * rows_h}, 3.015, tz.dx);
+    g.mirrored_layers = mirrored;
     const int L = 6;  // 2 horizons
     g.layers = {{{L, L}, {L, L}}};
     const double W = 6 * tz.dx, top = 2 * rows_h * tz.dx, d = tz.dx;
@@ -429,58 +433,68 @@ struct ColumnRun {
 // H = 10 dx and 20 dx, checks that the error halves, and holds the Richardson extrapolation
 // 2 f(20) - f(10) of the degree of consolidation U and of p at the impervious plane to
 // VALIDATION's 3 % of p0.
-TEST(HydroMechanical, TerzaghiConsolidation) {
-  const double Tvs[3] = {0.1, 0.2, 0.5};
-  struct Result {
-    double U[3], U_cf[3], base[3], base_cf[3], worst[3];
-  };
-  auto solve = [&](int N) {
-    Terzaghi tz;
-    tz.N = N;
-    tz.H = N * tz.dx;
-    tz.transit = 2 * tz.H / tz.c_u;
-    tz.t_c = 400 * tz.transit;
-    tz.c_v = tz.H * tz.H / tz.t_c;
-    tz.mobility = tz.c_v * tz.S;
-    tz.t_r = 10 * tz.transit;
-    ColumnRun run(tz, N, false, 0.5);
-    const auto& pts = run.disc.points;
-    Result r{};
-    for (int k = 0; k < 3; ++k) {
-      run.run_to(Tvs[k] * tz.t_c);
-      const double t = run.time();
-      auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
-      auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.p);
-      auto flags = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.flags);
-      double worst = 0, sum = 0, count = 0, base = 0, base_n = 0;
-      for (std::size_t i = 0; i < pts.n_owned; ++i) {
-        if (flags(i) & kFlagBoundaryLayer)
-          continue;
-        // Distance from the nearer drained face (y = 0 or 2H): the layer's coordinate z.
-        const double z = std::min(x(i, 1), 2 * tz.H - x(i, 1));
-        sum += p(i);
-        count += 1;
-        if (z > 3 * tz.dx)
-          worst = std::max(worst, std::abs(p(i) - tz.closed_form(z, t)) / tz.p0);
-        if (z > tz.H - tz.dx) {  // the two rows next to the impervious plane z = H
-          base += p(i);
-          base_n += 1;
-        }
+namespace {
+struct TerzaghiResult {
+  double U[3], U_cf[3], base[3], base_cf[3], worst[3];
+};
+const double kTvs[3] = {0.1, 0.2, 0.5};
+// The column with H = N dx to T_v = 0.1, 0.2, 0.5: the worst |p - p_cf| / p0 beyond `skip`
+// spacings from the drained face, the degree of consolidation U and p at the impervious plane.
+TerzaghiResult solve_terzaghi(int N, bool mirrored, double skip) {
+  const double* Tvs = kTvs;
+  using Result = TerzaghiResult;
+  Terzaghi tz;
+  tz.N = N;
+  tz.H = N * tz.dx;
+  tz.transit = 2 * tz.H / tz.c_u;
+  tz.t_c = 400 * tz.transit;
+  tz.c_v = tz.H * tz.H / tz.t_c;
+  tz.mobility = tz.c_v * tz.S;
+  tz.t_r = 10 * tz.transit;
+  ColumnRun run(tz, N, false, 0.5, true, mirrored);
+  const auto& pts = run.disc.points;
+  Result r{};
+  for (int k = 0; k < 3; ++k) {
+    run.run_to(Tvs[k] * tz.t_c);
+    const double t = run.time();
+    auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
+    auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.p);
+    auto flags = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.flags);
+    double worst = 0, sum = 0, count = 0, base = 0, base_n = 0;
+    for (std::size_t i = 0; i < pts.n_owned; ++i) {
+      if (flags(i) & kFlagBoundaryLayer)
+        continue;
+      // Distance from the nearer drained face (y = 0 or 2H): the layer's coordinate z.
+      const double z = std::min(x(i, 1), 2 * tz.H - x(i, 1));
+      sum += p(i);
+      count += 1;
+      if (z > skip * tz.dx)
+        worst = std::max(worst, std::abs(p(i) - tz.closed_form(z, t)) / tz.p0);
+      if (z > tz.H - tz.dx) {  // the two rows next to the impervious plane z = H
+        base += p(i);
+        base_n += 1;
       }
-      r.worst[k] = global_max(worst);
-      r.U[k] = 1 - global_sum(sum) / global_sum(count) / tz.p0;
-      r.U_cf[k] = 1 - tz.closed_form_mean(t) / tz.p0;
-      r.base[k] = global_sum(base) / global_sum(base_n) / tz.p0;
-      r.base_cf[k] = tz.closed_form(tz.H, t) / tz.p0;
-      if (test::world()->getRank() == 0)
-        std::printf(
-            "[ terzaghi ] H = %2d dx, T_v = %.3f: max |p - p_cf|/p0 = %.4f (z > 3 dx), "
-            "U = %.4f (closed form %.4f), p/p0 at z = H %.4f (closed form %.4f)\n",
-            N, tz.c_v * t / (tz.H * tz.H), r.worst[k], r.U[k], r.U_cf[k], r.base[k], r.base_cf[k]);
     }
-    return r;
-  };
-  const Result coarse = solve(10), fine = solve(20);
+    r.worst[k] = global_max(worst);
+    r.U[k] = 1 - global_sum(sum) / global_sum(count) / tz.p0;
+    r.U_cf[k] = 1 - tz.closed_form_mean(t) / tz.p0;
+    r.base[k] = global_sum(base) / global_sum(base_n) / tz.p0;
+    r.base_cf[k] = tz.closed_form(tz.H, t) / tz.p0;
+    if (test::world()->getRank() == 0)
+      std::printf(
+          "[ terzaghi ] %s layers, H = %2d dx, T_v = %.3f: max |p - p_cf|/p0 = %.4f (z > %g "
+          "dx), U = %.4f (closed form %.4f), p/p0 at z = H %.4f (closed form %.4f)\n",
+          mirrored ? "mirrored" : "constant", N, tz.c_v * t / (tz.H * tz.H), r.worst[k], skip,
+          r.U[k], r.U_cf[k], r.base[k], r.base_cf[k]);
+  }
+  return r;
+}
+}  // namespace
+
+TEST(HydroMechanical, TerzaghiConsolidation) {
+  const double* Tvs = kTvs;
+  using Result = TerzaghiResult;
+  const Result coarse = solve_terzaghi(10, false, 3), fine = solve_terzaghi(20, false, 3);
   for (int k = 0; k < 3; ++k) {
     SCOPED_TRACE("T_v = " + std::to_string(Tvs[k]));
     EXPECT_LT(std::abs(fine.U[k] - fine.U_cf[k]), 0.6 * std::abs(coarse.U[k] - coarse.U_cf[k]));
@@ -494,6 +508,30 @@ TEST(HydroMechanical, TerzaghiConsolidation) {
     EXPECT_NEAR(U_x, fine.U_cf[k], 0.03);
     EXPECT_NEAR(base_x, fine.base_cf[k], 0.03);
   }
+}
+
+// Mirrored drained layers (Boundary Layer Values = Mirrored: p = -p(mirror) in the layers) put
+// the drained face where it is. The same column with the paper's constant layers and with
+// mirrored ones, errors beyond the first 2 dx: the mirrored layers must at least halve the
+// error at every T_v, and meet the boundary-layer issue's acceptance where this measured it
+// met (max |p - p_cf| / p0 <= 2 % at H = 20 dx and U within 1 % at T_v = 0.2, 0.5; <= 1 % at
+// H = 40 dx and T_v = 0.5). Measured (constant -> mirrored, H = 20 dx): 11.5 -> 3.7 %,
+// 8.0 -> 1.0 %, 6.0 -> 1.1 % at T_v = 0.1, 0.2, 0.5; mirrored at H = 40 dx 3.0, 1.02, 0.75 %.
+// The issue's 2 % / 1 % at T_v = 0.1 and its 1 % at T_v = 0.2, H = 40 dx are not met: those
+// errors barely change with dx (3.7 -> 3.0 %, 0.99 -> 1.02 %), so they are not the face's
+// (left open in the issue).
+TEST(HydroMechanical, TerzaghiMirroredLayers) {
+  const TerzaghiResult c20 = solve_terzaghi(20, false, 2), r20 = solve_terzaghi(20, true, 2),
+                       r40 = solve_terzaghi(40, true, 2);
+  for (int k = 0; k < 3; ++k) {
+    SCOPED_TRACE("T_v = " + std::to_string(kTvs[k]));
+    EXPECT_LT(r20.worst[k], 0.5 * c20.worst[k]);
+    if (k >= 1) {
+      EXPECT_LE(r20.worst[k], 0.02);
+      EXPECT_NEAR(r20.U[k], r20.U_cf[k], 0.01);
+    }
+  }
+  EXPECT_LE(r40.worst[2], 0.01);
 }
 
 // Solid First and Fluid First are two first-order splittings of the same equations: their

@@ -81,6 +81,12 @@ struct BoundaryCondition {
   int component = 0;              // axis (rotation component for MicroRotation)
   double value = 0;
   TimeFunction time;
+  // Pore Pressure only (Discretization->Boundary Layer Values = Mirrored): the boundary-layer
+  // points take 2 g - p(mirror), the odd reflection about the face (FluidSolver::set_pressure).
+  bool mirrored = false;
+  // Column of Discretization::mirror it reflects with: the axis of the face its region lies
+  // outside of (face_column in mesh/grid.hpp), or Dim (its points outside one face only).
+  int mirror_column = 0;
   bool kinematic() const {
     return kind == Displacement || kind == Velocity || kind == MicroRotation;
   }

@@ -22,6 +22,9 @@ struct Discretization {
   Points<Dim> points;
   Bonds bonds;
   ShapeTensors<Dim> shape;  // of the intact bonds: update_shape() after any change of them
+  // Local indices of each owned boundary-layer point's mirrors (mirror_locals in grid.hpp);
+  // empty unless grid.mirrored_layers.
+  View2<LocalId> mirror;
 
   void update_shape() { update_shape_tensors(points, bonds, shape); }
 };
@@ -95,6 +98,7 @@ Discretization<Dim> discretize(const Teuchos::RCP<const Comm>& comm, const GridS
     Kokkos::deep_copy(disc.points.gid, gid);
   }
   exchange_constants(disc.dist, disc.points);
+  disc.mirror = mirror_locals(grid, owned, ghosts);
   disc.bonds = build_bonds(disc.points, grid.horizon, grid.cracks);
   disc.update_shape();
   return disc;

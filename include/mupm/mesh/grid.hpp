@@ -23,6 +23,9 @@ struct GridSpec {
   double horizon = 0;                            // delta (absolute)
   double thickness = 1;                          // out-of-plane thickness (2D)
   std::array<std::array<int, 2>, Dim> layers{};  // boundary-layer rows on face (axis, side)
+  // Some condition mirrors its boundary-layer values (kernels/boundary_conditions.hpp): the
+  // mirrors of the owned layer points become ghosts too.
+  bool mirrored_layers = false;
   std::vector<Crack> cracks;
   std::vector<std::string> region_names;
   std::vector<Box> regions;
@@ -129,6 +132,55 @@ std::vector<GlobalId> box_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& b)
   return out;
 }
 
+// The mirror of lattice point idx across the face of axis `axis` it lies outside of (the
+// boundary-layer issue): a layer index k < 0 of the real body's numbering goes to -1 - k and
+// k >= n to 2n - 1 - k, the point at the same distance inside the face (points sit at cell
+// centres, the face on a cell boundary, so the mirror is a lattice point; layers thicker than
+// the body clamp into it). Returns false if idx is not outside that face. The mirror of a corner
+// (or 3D edge) point across one face is a layer point of the other face.
+template <int Dim>
+bool mirror_index(const GridSpec<Dim>& g, const long long* idx, int axis, long long* out) {
+  for (int d = 0; d < Dim; ++d)
+    out[d] = idx[d];
+  const long long n = g.counts[axis], k = idx[axis] - g.layers[axis][0];
+  if (k >= 0 && k < n)
+    return false;
+  long long m = k < 0 ? -1 - k : 2 * n - 1 - k;
+  m = std::min(std::max(m, 0LL), n - 1);
+  out[axis] = m + g.layers[axis][0];
+  return true;
+}
+
+// The axis whose face a region lies entirely outside of (its box beyond the face: the
+// boundary layers, or a user's box of layer rows), -1 if none or several: the face a mirrored
+// condition on the region reflects across.
+template <int Dim>
+int face_axis(const GridSpec<Dim>& g, std::uint32_t mask) {
+  if (mask == 0 || (mask & (mask - 1)) != 0)
+    return -1;
+  int r = 0;
+  while (!(mask & (1u << r)))
+    ++r;
+  if (r >= int(g.regions.size()))
+    return -1;
+  const Box& b = g.regions[r];
+  int axis = -1, count = 0;
+  for (int d = 0; d < Dim; ++d) {
+    const double lo = g.origin[d], hi = g.origin[d] + g.counts[d] * g.dx;
+    if (b.hi[d] < lo || b.lo[d] > hi) {
+      axis = d;
+      ++count;
+    }
+  }
+  return count == 1 ? axis : -1;
+}
+// The column of Discretization::mirror a condition on region `mask` reflects with.
+template <int Dim>
+int face_column(const GridSpec<Dim>& g, std::uint32_t mask) {
+  const int axis = face_axis(g, mask);
+  return axis >= 0 ? axis : Dim;
+}
+
 // Ghost candidates of an owned box: lattice points outside it within delta of one of its points.
 // The nearest owned point of a lattice point is its index clamped to the box, so the test is
 // exact.
@@ -158,7 +210,67 @@ std::vector<GlobalId> ghost_gids(const GridSpec<Dim>& g, const LatticeBox<Dim>& 
     if (!inside && within_horizon(d2, delta2))
       out.push_back(lattice_gid<Dim>(idx, n));
   });
-  return out;  // ascending: the walk is in global-id order
+  if (g.mirrored_layers) {  // the mirrors of the owned layer points, where outside the box
+    for_each_in_box(b, [&](const long long* idx) {
+      long long m[Dim];
+      for (int axis = 0; axis < Dim; ++axis) {
+        if (!mirror_index(g, idx, axis, m))
+          continue;
+        bool inside = true;
+        for (int d = 0; d < Dim; ++d)
+          inside = inside && m[d] >= b.lo[d] && m[d] < b.hi[d];
+        if (!inside)
+          out.push_back(lattice_gid<Dim>(m, n));
+      }
+    });
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+  return out;  // ascending
+}
+
+// Local indices (owned, then ghosts) of each owned point's mirrors: column d the mirror across
+// the face of axis d (mirror_index; -1 if the point is not outside it), column Dim the mirror
+// of a point outside one face only (-1 for body, corner and 3D edge points). Empty unless
+// g.mirrored_layers.
+template <int Dim>
+View2<LocalId> mirror_locals(const GridSpec<Dim>& g, const std::vector<GlobalId>& owned,
+                             const std::vector<GlobalId>& ghosts) {
+  if (!g.mirrored_layers)
+    return View2<LocalId>();
+  long long n[Dim];
+  for (int d = 0; d < Dim; ++d)
+    n[d] = g.lattice_count(d);
+  auto local_of = [&](GlobalId gid) -> LocalId {
+    auto it = std::lower_bound(owned.begin(), owned.end(), gid);
+    if (it != owned.end() && *it == gid)
+      return LocalId(it - owned.begin());
+    it = std::lower_bound(ghosts.begin(), ghosts.end(), gid);
+    return LocalId(owned.size() + (it - ghosts.begin()));  // present by ghost_gids
+  };
+  View2<LocalId> mirror("mupm::mirror", owned.size(), Dim + 1);
+  auto h = Kokkos::create_mirror_view(mirror);
+  for (std::size_t i = 0; i < owned.size(); ++i) {
+    long long idx[Dim], m[Dim];
+    GlobalId rest = owned[i];
+    for (int d = 0; d < Dim; ++d) {
+      idx[d] = rest % n[d];
+      rest /= n[d];
+    }
+    int outside = 0;
+    h(i, Dim) = -1;
+    for (int d = 0; d < Dim; ++d) {
+      h(i, d) = mirror_index(g, idx, d, m) ? local_of(lattice_gid<Dim>(m, n)) : -1;
+      if (h(i, d) >= 0) {
+        ++outside;
+        h(i, Dim) = h(i, d);
+      }
+    }
+    if (outside != 1)
+      h(i, Dim) = -1;
+  }
+  Kokkos::deep_copy(mirror, h);
+  return mirror;
 }
 
 // Fills gid, x, volume, flags and regions of the owned points from their global ids, and marks

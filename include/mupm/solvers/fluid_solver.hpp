@@ -72,6 +72,8 @@ class FluidSolver : public Module {
               MPI_Comm comm)
       : disc_(disc), prm_(prm), comm_(comm) {
     for (auto& bc : bcs)
+      bc.mirror_column = face_column(disc.grid, bc.region_mask);
+    for (auto& bc : bcs)
       if (bc.fluid() && !bc.fracture_fluid())
         bcs_.push_back(bc);
     all_bcs_ = bcs;
@@ -195,8 +197,13 @@ class FluidSolver : public Module {
       MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_SUM, comm_);
       region_volume_[k] = v;
     }
+    mark_mirrored();
     if (!restarted) {
       set_pressure(t, p.p);
+      if (mirrored_.extent(0) > 0) {
+        disc_.dist.refresh({as_vectors(p.p)});
+        set_pressure(t, p.p, true);
+      }
       energy_.stored0 = stored_energy();
       fluid_constitutive(p, prm_, st_);
       auto pw = p.p, phi = p.porosity, sr = p.saturation, m = p.fluid_content;
@@ -297,6 +304,10 @@ class FluidSolver : public Module {
         op, 1, p.n_owned, p.gid, p.volume,
         [&] {
           disc_.dist.refresh({as_vectors(x)});
+          if (mirrored_.extent(0) > 0) {  // the layers mirror the perturbation (g = 0)
+            mirror_pressure(x);
+            disc_.dist.refresh({as_vectors(x)});
+          }
           fluid_flow(disc_, prm_, st_, x, false);
         },
         comm_, iterations);
@@ -331,18 +342,64 @@ class FluidSolver : public Module {
   }
 
   // p = value g(t) on the points of every pressure condition (later conditions win).
-  void set_pressure(double t, const Scalars& target) {
+  // `mirror`: the mirrored layer points only (mirrored_), 2 g - p(mirror) (kernels/
+  // boundary_conditions.hpp: the mirrors' pressures current on the ghosts); otherwise g on all.
+  void set_pressure(double t, const Scalars& target, bool mirror = false) {
     auto& p = disc_.points;
     auto regions = p.regions;
+    const auto m = disc_.mirror;
+    const Bytes only = mirrored_;
     for (const auto& bc : bcs_) {
       if (bc.kind != BoundaryCondition::PorePressure)
         continue;
       const std::uint32_t mask = bc.region_mask;
       const double v = bc.value * bc.time(t);
+      auto pw = p.p;
+      const bool reflect = mirror && bc.mirrored;
+      const int col = bc.mirror_column;
       Kokkos::parallel_for(
           "mupm::Fluid::pressure_bc", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+            if ((mask != 0 && !(regions(i) & mask)) || (mirror && !only(i)))
+              return;
+            target(i) = reflect ? 2 * v - pw(m(i, col)) : v;
+          });
+    }
+  }
+  // x = -x(mirror) on the mirrored layer points (a perturbation: g = 0), reading the values
+  // from before the update as set_pressure does.
+  void mirror_pressure(const Scalars& x) {
+    const auto m = disc_.mirror;
+    const Bytes only = mirrored_;
+    Scalars src("mupm::mirror_sources", x.extent(0));
+    Kokkos::deep_copy(src, x);
+    Kokkos::parallel_for(
+        "mupm::Fluid::mirror_perturbation", range(0, disc_.points.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i) {
+          if (only(i))
+            x(i) = -src(m(i, only(i) - 1));
+        });
+  }
+  // Marks the points whose (last) pressure condition mirrors its layer values (1 + the column of
+  // Discretization::mirror it reflects with); empty if none.
+  void mark_mirrored() {
+    bool any = false;
+    for (const auto& bc : bcs_)
+      any = any || (bc.kind == BoundaryCondition::PorePressure && bc.mirrored);
+    if (!any)
+      return;
+    auto& p = disc_.points;
+    mirrored_ = Bytes("mupm::mirrored_pressure", p.n_owned);
+    auto regions = p.regions;
+    const auto m = disc_.mirror, flag = mirrored_;
+    for (const auto& bc : bcs_) {
+      if (bc.kind != BoundaryCondition::PorePressure)
+        continue;
+      const std::uint32_t mask = bc.region_mask;
+      const int col = bc.mirror_column, on = bc.mirrored ? col + 1 : 0;
+      Kokkos::parallel_for(
+          "mupm::Fluid::mark_mirrored", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
             if (mask == 0 || (regions(i) & mask))
-              target(i) = v;
+              flag(i) = std::uint8_t(on && m(i, col) >= 0 ? on : 0);
           });
     }
   }
@@ -382,7 +439,8 @@ class FluidSolver : public Module {
     const double inv_total = 1.0 / dt_total;
     if (fracture_) {
       // The bulk's explicit step without the exchange (p^ of fracture_flow.hpp), then the
-      // exchange the fracture step takes, as a sink in the update below.
+      // exchange the fracture step takes, as a sink in the update below. (Mirrored layer
+      // points enter p^ with g, not their mirrored value: layers are far from cracks.)
       auto phat = phat_, sink = sink_;
       Kokkos::parallel_for(
           "mupm::Fluid::predictor", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
@@ -397,36 +455,53 @@ class FluidSolver : public Module {
           KOKKOS_LAMBDA(const std::size_t i) { src(i) -= sink(i); });
     }
     double w[3] = {0, 0, 0};  // coupling work, flow dissipation, external work (energy_ doc)
-    Kokkos::parallel_reduce(
-        "mupm::Fluid::update", range(0, p.n_owned),
-        KOKKOS_LAMBDA(const std::size_t i, double& wc, double& wd, double& we) {
-          const double dv = (vs(i) - ref(i)) * inv_total * dt;  // eq 117 over this step
-          const double rhs = -sr(i) * dv + dt * (src(i) - flow(i));
-          double dp;
-          const double p0 = pw(i);
-          if (fixed(i) & kFixedPressure) {
-            dp = target(i) - p0;
-            target(i) = vol(i) * (C(i) * dp - rhs);  // what the reservoir supplies [m^3]
-          } else {
-            dp = C(i) > 0 ? rhs / C(i) : 0.0;  // eq 143
-            target(i) = 0;
-          }
-          const double pm = p0 + 0.5 * dp;  // the step's mean pressure
-          // Where water comes in or out (sources, reservoirs): the pressure at which the stored
-          // energy takes it, [psi(p0 + dp) - psi(p0)] / (C dp) (pm when C is constant).
-          double pe = pm;
-          if ((src(i) != 0 || (fixed(i) & kFixedPressure)) && C(i) * dp != 0)
-            pe = (stored_energy_density(vg, phi(i), inv_kw, p0 + dp) -
-                  stored_energy_density(vg, phi(i), inv_kw, p0)) /
-                 (C(i) * dp);
-          wc += vol(i) * pm * sr(i) * dv;
-          wd += vol(i) * p0 * dt * flow(i);
-          we += vol(i) * pe * dt * src(i) + pe * target(i);
-          m(i) += C(i) * dp + sr(i) * dv;
-          rate(i) = dp / dt;
-          pw(i) = p0 + dp;  // eq 145, beta_3 = 0
-        },
-        w[0], w[1], w[2]);
+    // Phase 0 updates every point but the mirrored layer points (mirrored_), whose prescribed
+    // values follow their mirrors' new pressures: phase 1, after a ghost refresh.
+    const Bytes mirrored = mirrored_;
+    const bool any_mirrored = mirrored.extent(0) > 0;
+    auto update = [&](const int phase) {
+      double ws[3] = {0, 0, 0};
+      Kokkos::parallel_reduce(
+          "mupm::Fluid::update", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i, double& wc, double& wd, double& we) {
+            if (any_mirrored && (mirrored(i) != 0) != (phase == 1))
+              return;
+            const double dv = (vs(i) - ref(i)) * inv_total * dt;  // eq 117 over this step
+            const double rhs = -sr(i) * dv + dt * (src(i) - flow(i));
+            double dp;
+            const double p0 = pw(i);
+            if (fixed(i) & kFixedPressure) {
+              dp = target(i) - p0;
+              target(i) = vol(i) * (C(i) * dp - rhs);  // what the reservoir supplies [m^3]
+            } else {
+              dp = C(i) > 0 ? rhs / C(i) : 0.0;  // eq 143
+              target(i) = 0;
+            }
+            const double pm = p0 + 0.5 * dp;  // the step's mean pressure
+            // Where water comes in or out (sources, reservoirs): the pressure at which the stored
+            // energy takes it, [psi(p0 + dp) - psi(p0)] / (C dp) (pm when C is constant).
+            double pe = pm;
+            if ((src(i) != 0 || (fixed(i) & kFixedPressure)) && C(i) * dp != 0)
+              pe = (stored_energy_density(vg, phi(i), inv_kw, p0 + dp) -
+                    stored_energy_density(vg, phi(i), inv_kw, p0)) /
+                   (C(i) * dp);
+            wc += vol(i) * pm * sr(i) * dv;
+            wd += vol(i) * p0 * dt * flow(i);
+            we += vol(i) * pe * dt * src(i) + pe * target(i);
+            m(i) += C(i) * dp + sr(i) * dv;
+            rate(i) = dp / dt;
+            pw(i) = p0 + dp;  // eq 145, beta_3 = 0
+          },
+          ws[0], ws[1], ws[2]);
+      for (int k = 0; k < 3; ++k)
+        w[k] += ws[k];
+    };
+    update(0);
+    if (any_mirrored) {
+      disc_.dist.refresh({as_vectors(p.p)});
+      set_pressure(t + dt, target, true);
+      update(1);
+    }
     std::vector<double> supplied(bcs_.size() + 3, 0.0);
     supplied[bcs_.size()] = w[0];
     supplied[bcs_.size() + 1] = w[1];
@@ -474,6 +549,7 @@ class FluidSolver : public Module {
   Scalars phat_, sink_;
   double mass0_ = 0;  // water in the body at t = 0 [kg]
   Scalars source_, supply_;
+  Bytes mirrored_;  // mark_mirrored()
   std::vector<double> inflow_, region_volume_;
   Energy energy_;
 };
