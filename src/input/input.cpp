@@ -136,11 +136,16 @@ void bc_template(ParameterList& c) {
   c.set("Times", Array<double>(), "Table times [s], increasing (Time Function = Table).");
   c.set("Values", Array<double>(), "Table values (Time Function = Table), as many as Times.");
   c.set("Boundary Layer Values", std::string("Default"),
-        "Pore Pressure on boundary-layer points: Constant (the prescribed value g, the paper's "
-        "method) or Mirrored (2 g - p of the body point mirrored about the face, so that p "
-        "passes through g at the face); Default: Discretization->Boundary Layer Values. Points "
-        "of the region that are not layer points hold g either way. Displacement, Velocity and "
-        "Micro-Rotation are Constant only (README, 'Boundary layers').",
+        "Values on boundary-layer points. Pore Pressure: Constant (the prescribed value g, the "
+        "paper's method) or Mirrored (2 g - p of the body point mirrored about the face, so that "
+        "p passes through g at the face); Default: Discretization->Boundary Layer Values. "
+        "Displacement (Physics = Micropolar Solid): Mirrored (this parameter only) needs "
+        "Component = the normal of the face "
+        "its region lies outside of, and makes the layer the mirror image of the body about a "
+        "symmetry plane at u_n = g (u_n = 2 g - u_n, u_t and theta reflected: a roller with "
+        "zero tangential micro-rotation); Default and Constant hold g. Points of the region "
+        "that are not layer points hold g either way. Velocity and Micro-Rotation are Constant "
+        "only (README, 'Boundary layers').",
         one_of({"Default", "Constant", "Mirrored"}));
 }
 
@@ -200,7 +205,8 @@ RCP<ParameterList> valid_parameters() {
           "paper's method; the face then drains as if it sat about 0.7 delta farther out). "
           "Mirrored: a layer point at distance d outside the face takes 2 g - p(m), p(m) the "
           "pressure of the point m at distance d inside, every fluid substep (the face: the one "
-          "the condition's region lies outside of). Kinematic conditions stay Constant. See "
+          "the condition's region lies outside of). Kinematic conditions stay Constant unless "
+          "their own Boundary Layer Values says Mirrored (Displacement only). See "
           "README, 'Boundary layers'.",
           one_of({"Constant", "Mirrored"}));
     ParameterList& r = d.sublist("Regions", false,
@@ -780,14 +786,16 @@ void check_dimension_arrays(ParameterList& input) {
       throw InputError("Error, " + path_of(c, "Component") + " = " + comp + ": a " +
                        std::to_string(dim) + "D body has components x" +
                        (dim == 3 ? ", y and z." : " and y."));
-    // Mirrored kinematic layers were built and measured unstable (the odd reflection of every
-    // component of a held face is not an invariant subspace of the vector operator: Terzaghi's
-    // column grew without bound at H = 40 dx), so they are refused rather than run.
+    // An odd reflection of the held components alone was built and measured unstable (it is not
+    // an invariant subspace of the vector operator: Terzaghi's column grew without bound at
+    // H = 40 dx). Displacement conditions mirror by the reflection R instead, which the operator
+    // commutes with (mirror_kinematic, kernels/boundary_conditions.hpp); Velocity and
+    // Micro-Rotation are refused rather than run.
     if (c.get<std::string>("Boundary Layer Values") == "Mirrored" &&
-        type != BoundaryCondition::PorePressure)
+        type != BoundaryCondition::PorePressure && type != BoundaryCondition::Displacement)
       throw InputError("Error, " + path_of(c, "Boundary Layer Values") +
-                       " = Mirrored: only Pore Pressure conditions mirror their boundary-layer "
-                       "values; " +
+                       " = Mirrored: only Pore Pressure and Displacement conditions mirror their "
+                       "boundary-layer values; " +
                        c.get<std::string>("Type") +
                        " conditions hold the prescribed value (write Constant or Default).");
     const auto tf = time_function_options()(c.get<std::string>("Time Function"));
@@ -1304,7 +1312,11 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterLis
     std::string values = c.get<std::string>("Boundary Layer Values");
     if (values == "Default")
       values = input.sublist("Discretization").get<std::string>("Boundary Layer Values");
-    bc.mirrored = bc.kind == BoundaryCondition::PorePressure && values == "Mirrored";
+    // The Discretization's default reaches Pore Pressure only; a Displacement condition mirrors
+    // when it says so itself (it then sets every component of its layer: mirror_kinematic).
+    bc.mirrored = (bc.kind == BoundaryCondition::PorePressure && values == "Mirrored") ||
+                  (bc.kind == BoundaryCondition::Displacement &&
+                   c.get<std::string>("Boundary Layer Values") == "Mirrored");
     out.push_back(bc);
   }
   return out;

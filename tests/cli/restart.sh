@@ -81,6 +81,9 @@ check solid inputs/quickstart.xml 40 7
 check coupled inputs/consolidation.xml 60 14
 # Mirrored drained layers: their mirrors' pressures travel with the ghosts.
 check coupled-mirrored inputs/consolidation.xml 60 14 's|<Parameter name="Boundary Layers"|<Parameter name="Boundary Layer Values" type="string" value="Mirrored"/>&|'
+# Mirrored displacement layers (the quick start's plate pulled through mirrored top and bottom
+# layers): the layers follow their mirrors, which travel with the ghosts.
+check solid-mirrored inputs/quickstart.xml 40 7 's|(<Parameter name="Component" type="string" value="y"/>)|\1<Parameter name="Boundary Layer Values" type="string" value="Mirrored"/>|'
 check fracture tests/cli/fracture_small.xml 440 10
 # The J criterion (Algorithm 3): the crack advances by increments from step ~200.
 check fracture-j tests/cli/fracture_small.xml 440 12 's|value="Energy"/>|value="J-Integral"/>|; s|  <ParameterList name="Boundary Conditions">|  <ParameterList name="J-Integral"><Parameter name="Half Widths" type="Array(double)" value="{4, 5}"/></ParameterList>\n&|'

@@ -1,5 +1,6 @@
-// The solid step with boundary conditions: a bar under traction (static equilibrium against
-// the closed form and exact reaction), and the stable-step estimate against the actual
+// The solid step with boundary conditions: bars under traction and under end displacements
+// (static equilibrium against the closed form and exact reaction; constant and mirrored
+// layers), a body couple, and the stable-step estimate against the actual
 // stability limit of the central-difference scheme.
 #include <gtest/gtest.h>
 
@@ -19,72 +20,159 @@ SolidParams params(const MicropolarElastic& law, const GridSpec<2>& g) {
 const MicropolarElastic kLaw =
     MicropolarElastic::from_bulk_shear(270.83e6, 220.33e6, 100e6, 7.5e-3);
 
-// Bar 0 <= x <= L, 0 <= y <= H, held at x = 0 by a boundary layer (u_x = 0), traction t on the
-// outermost column at x = L. At rest: sigma_xx = t, sigma_yy = 0 (free sides), plane strain:
-// eps_xx = t (1 - nu^2) / E; the reaction equals -t H exactly.
-TEST(SolidSolver, BarUnderTraction) {
-  const double dx = 2.5e-3, t = 1e5;
-  auto g = test::box<2>({40, 8}, 3.015, dx);
-  g.layers[0] = {6, 0};
-  const double L = 40 * dx, H = 8 * dx;
-  Box left, right;
-  left.lo[0] = -1;
-  left.hi[0] = -0.25 * dx;
-  left.lo[1] = -1;
-  left.hi[1] = 1;
-  right.lo[0] = L - dx;
-  right.hi[0] = L;
-  right.lo[1] = -1;
-  right.hi[1] = 1;
-  g.region_names = {"left", "right"};
-  g.regions = {left, right};
+// A bar loaded through its two end faces (the boundary-layer issue, item 5): free in y, held
+// at x = 0 and loaded at x = L as `load` says, run to rest. Returns the owned points' x and u
+// (gathered on every rank, sorted by gid) and the reaction of the first condition.
+struct BarResult {
+  std::vector<double> x, u;
+  double reaction = 0;
+};
+BarResult bar_to_rest(const GridSpec<2>& g, std::vector<BoundaryCondition> bcs, int steps) {
   auto disc = discretize(test::world(), g);
   Kokkos::deep_copy(disc.points.saturation, 1.0);
-  BoundaryCondition hold, pull;
-  hold.name = "hold";
-  hold.kind = BoundaryCondition::Displacement;
-  hold.region_mask = 1u << 0;
-  hold.component = 0;
-  pull.name = "pull";
-  pull.kind = BoundaryCondition::Traction;
-  pull.region_mask = 1u << 1;
-  pull.component = 0;
-  pull.value = t;
   typename SolidSolver<2>::Settings set;
+  const double L = g.counts[0] * g.dx;
   const double c_p = std::sqrt((kLaw.lambda + 2 * kLaw.mu) / set.rho_s);
   set.damping = 2 * kPi * c_p / (4 * L) * 2;  // about critical for the first axial mode
-  SolidSolver<2> solver(disc, params(kLaw, g), {hold, pull}, set, MPI_COMM_WORLD);
+  SolidSolver<2> solver(disc, params(kLaw, g), bcs, set, MPI_COMM_WORLD);
   solver.initialize(0.0, false);
   const double dt = 0.5 * solver.estimate_stable_dt();
   double time = 0;
-  for (int n = 0; n < 6000; ++n, time += dt)
+  for (int n = 0; n < steps; ++n, time += dt)
     solver.step(time, dt);
-
-  const double E = kLaw.young(), nu = kLaw.poisson();
-  const double strain = t * (1 - nu * nu) / E;
-  // Strain from the displacement of the middle row between x = L/4 and 3L/4.
+  const auto e = solver.energy();
+  EXPECT_LT(e.kinetic, 1e-8 * e.internal);  // at rest
+  EXPECT_LT(std::abs(e.balance()), 1e-3 * e.external_work);
   auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.x);
   auto u = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.u);
-  double ua = 0, ub = 0;
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.gid);
+  const std::size_t total = std::size_t(disc.grid.n_global());
+  BarResult r;
+  r.x.assign(total, 0.0);
+  r.u.assign(total, 0.0);
   for (std::size_t i = 0; i < disc.points.n_owned; ++i) {
-    if (std::abs(x(i, 1) - 4.5 * dx) > 0.1 * dx)
-      continue;
-    if (std::abs(x(i, 0) - 10.5 * dx) < 0.1 * dx)
-      ua = u(i, 0);
-    if (std::abs(x(i, 0) - 30.5 * dx) < 0.1 * dx)
-      ub = u(i, 0);
+    r.x[gid(i)] = x(i, 0);
+    r.u[gid(i)] = u(i, 0);
   }
-  MPI_Allreduce(MPI_IN_PLACE, &ua, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  MPI_Allreduce(MPI_IN_PLACE, &ub, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  const double measured = (ub - ua) / (20 * dx);
-  RecordProperty("strain_ratio", std::to_string(measured / strain));
-  EXPECT_NEAR(measured / strain, 1.0, 0.03) << measured << " vs " << strain;
-  const auto r = solver.reactions();
-  ASSERT_EQ(r.size(), 1u);
-  EXPECT_NEAR(r[0], -t * H * g.thickness, 1e-3 * t * H) << "reaction";
-  const auto e = solver.energy();
-  EXPECT_LT(e.kinetic, 1e-6 * e.internal);  // at rest
-  EXPECT_LT(std::abs(e.balance()), 1e-3 * e.external_work);
+  MPI_Allreduce(MPI_IN_PLACE, r.x.data(), int(total), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, r.u.data(), int(total), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  r.reaction = solver.reactions().at(0);
+  return r;
+}
+
+// Mean u_x of the lattice column at x (all rows of the body and its layers).
+double column_u(const BarResult& r, double x, double dx) {
+  double sum = 0;
+  int n = 0;
+  for (std::size_t k = 0; k < r.x.size(); ++k)
+    if (std::abs(r.x[k] - x) < 0.1 * dx) {
+      sum += r.u[k];
+      ++n;
+    }
+  EXPECT_GT(n, 0) << "no column at " << x;
+  return sum / std::max(n, 1);
+}
+
+// Traction on the outer column (item 5 of the boundary-layer issue): the interior strain and
+// the reaction are exact; what the truncated families at the loaded face cost shows as the
+// loaded column's displacement beyond the interior's straight line, as a length: the face
+// acts as if it sat `surface_length` farther out.
+TEST(SolidSolver, BarUnderTraction) {
+  const double dx = 2.5e-3, t = 1e5;
+  for (const double factor : {3.015, 4.015}) {
+    auto g = test::box<2>({60, 8}, factor, dx);
+    g.layers[0] = {g.horizon_cells(), 0};
+    const double L = 60 * dx, H = 8 * dx;
+    Box left, right;
+    left.lo[0] = left.lo[1] = right.lo[1] = -1;
+    left.hi[0] = -0.25 * dx;
+    left.hi[1] = right.hi[1] = 1;
+    right.lo[0] = L - dx;
+    right.hi[0] = L;
+    g.region_names = {"left", "right"};
+    g.regions = {left, right};
+    BoundaryCondition hold, pull;
+    hold.name = "hold";
+    hold.kind = BoundaryCondition::Displacement;
+    hold.region_mask = 1u << 0;
+    pull.name = "pull";
+    pull.kind = BoundaryCondition::Traction;
+    pull.region_mask = 1u << 1;
+    pull.value = t;
+    const auto r = bar_to_rest(g, {hold, pull}, 12000);
+    const double E = kLaw.young(), nu = kLaw.poisson();
+    const double strain = t * (1 - nu * nu) / E;
+    const double xa = 20.5 * dx, xb = 40.5 * dx, xe = L - 0.5 * dx;
+    const double ua = column_u(r, xa, dx), ub = column_u(r, xb, dx), ue = column_u(r, xe, dx);
+    const double measured = (ub - ua) / (xb - xa);
+    const double surface_length = (ue - (ub + measured * (xe - xb))) / measured;
+    const std::string tag = "_delta" + std::to_string(int(factor));
+    RecordProperty("strain_ratio" + tag, std::to_string(measured / strain));
+    RecordProperty("surface_length_over_dx" + tag, std::to_string(surface_length / dx));
+    std::printf("delta %.3f dx: strain ratio %.6f, loaded face's excess %.4f dx (%.3f %% of L)\n",
+                factor, measured / strain, surface_length / dx, 100 * surface_length / L);
+    EXPECT_NEAR(measured / strain, 1.0, 0.005) << measured << " vs " << strain;
+    EXPECT_NEAR(r.reaction, -t * H * g.thickness, 1e-4 * t * H) << "reaction";
+  }
+}
+
+// A bar stretched by its end layers (u_x = 0 before x = 0, u_x = U beyond x = L, ramped; free in
+// y): eps = U / L, sigma_xx = E' eps (plane strain, free sides), reaction -sigma_xx H. Constant
+// layers make the body act longer (the kink at each face); mirrored layers (the body's mirror
+// image about u_x = g, mirror_kinematic) reproduce the uniform stretch, which is symmetric about
+// both faces, exactly when the layers are 2 delta thick (`horizons` = 2): then every layer point
+// that bonds to the body has a whole family, and its force state is the body's.
+double end_displacement_bar(bool mirrored, int horizons, double& reaction_ratio) {
+  const double dx = 2.5e-3, U = 1e-5;
+  auto g = test::box<2>({60, 8}, 3.015, dx);
+  g.layers[0] = {horizons * g.horizon_cells(), horizons * g.horizon_cells()};
+  g.mirrored_layers = mirrored;
+  const double L = 60 * dx, H = 8 * dx;
+  Box left, right;
+  left.lo[0] = left.lo[1] = right.lo[1] = -1;
+  left.hi[0] = -0.25 * dx;
+  left.hi[1] = right.hi[1] = right.hi[0] = 1;
+  right.lo[0] = L + 0.25 * dx;
+  g.region_names = {"left", "right"};
+  g.regions = {left, right};
+  BoundaryCondition hold, pull;
+  hold.name = "hold";
+  hold.kind = pull.kind = BoundaryCondition::Displacement;
+  hold.region_mask = 1u << 0;
+  pull.name = "pull";
+  pull.region_mask = 1u << 1;
+  pull.value = U;
+  pull.time.kind = TimeFunction::Ramp;
+  pull.time.ramp_time = 2e-3;  // about 2000 of the 12000 steps
+  hold.mirrored = pull.mirrored = mirrored;
+  const auto r = bar_to_rest(g, {hold, pull}, 12000);
+  const double E = kLaw.young(), nu = kLaw.poisson();
+  const double strain = U / L, stress = E / (1 - nu * nu) * strain;
+  const double xa = 20.5 * dx, xb = 40.5 * dx;
+  const double measured = (column_u(r, xb, dx) - column_u(r, xa, dx)) / (xb - xa);
+  reaction_ratio = -r.reaction / (stress * H * g.thickness);
+  return measured / strain;
+}
+
+TEST(SolidSolver, BarUnderEndDisplacement) {
+  double reaction_constant = 0, reaction_thin = 0, reaction_mirrored = 0;
+  const double constant = end_displacement_bar(false, 1, reaction_constant);
+  const double thin = end_displacement_bar(true, 1, reaction_thin);
+  const double mirrored = end_displacement_bar(true, 2, reaction_mirrored);
+  RecordProperty("strain_ratio_constant", std::to_string(constant));
+  RecordProperty("strain_ratio_mirrored_1_horizon", std::to_string(thin));
+  RecordProperty("strain_ratio_mirrored_2_horizons", std::to_string(mirrored));
+  std::printf(
+      "end displacement: strain ratio %.6f constant, %.6f mirrored (1 horizon), %.6f "
+      "mirrored (2 horizons); reaction ratio %.6f, %.6f, %.6f\n",
+      constant, thin, mirrored, reaction_constant, reaction_thin, reaction_mirrored);
+  EXPECT_NEAR(mirrored, 1.0, 0.005);
+  EXPECT_NEAR(reaction_mirrored, 1.0, 0.005);
+  EXPECT_NEAR(reaction_thin, thin, 1e-3);
+  // Constant layers: the body acts longer than L by about 0.7 dx per face (measured 2.3 % at
+  // L = 60 dx); the test pins that they are the worse, as the issue's measurement says.
+  EXPECT_LT(constant, mirrored);
+  EXPECT_NEAR(reaction_constant, constant, 1e-3);  // reaction and strain agree either way
 }
 
 // A uniform body couple m on a body whose displacements are held: at rest the Cosserat

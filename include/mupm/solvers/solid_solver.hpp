@@ -88,6 +88,11 @@ class SolidSolver : public Mechanics {
       : disc_(disc), prm_(prm), law_(law), bcs_(std::move(bcs)), set_(settings), comm_(comm) {
     if constexpr (std::is_same_v<Law, MicropolarElastic>)
       law_ = prm.law;
+    for (auto& bc : bcs_)
+      if (bc.kinematic() && bc.mirrored) {
+        bc.mirror_column = face_column(disc.grid, bc.region_mask);
+        mirrored_ = true;
+      }
     auto& p = disc_.points;
     st_.allocate(p.size(), p.n_owned);
     rho_ = Scalars("mupm::density", p.n_owned);
@@ -210,6 +215,8 @@ class SolidSolver : public Mechanics {
   void initialize(double t, bool restarted) override {
     auto& p = disc_.points;
     mark_fixed(bcs_, p);
+    if (mirrored_)
+      mark_mirrored_fixed(bcs_, p, disc_.mirror);
     update_density();
     // Pore water pressure, for the whole run: a fluid (undrained modulus set from the start), or
     // a held initial pressure (without a fluid p never changes). The effective force state's
@@ -217,8 +224,10 @@ class SolidSolver : public Mechanics {
     pressure_ = (breaks() || keep_pore_part_) && has_pressure();
     if (pressure_ && set_.fracture.effective_state && st_.P1w.extent(0) == 0)
       st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
-    if (!restarted)
+    if (!restarted) {
       apply_kinematic(bcs_, p, t, 0.0);
+      mirror_layers(t);
+    }
     disc_.dist.refresh({as_vectors(p.p), as_vectors(p.saturation)});  // constant in the solid step
     // The pair force states of this state start the bond energies' trapezoid. A restart keeps
     // the checkpoint's: they are the states the forces had when applied, with the pore pressure
@@ -250,6 +259,7 @@ class SolidSolver : public Mechanics {
     save_positions();
     advance_positions(p, dt);
     apply_kinematic(bcs_, p, t, dt);
+    mirror_layers(t + dt);
     increments();
     // Work, dissipation, pore work and bond breakage of the step (this rank's points), then one
     // reduction.
@@ -553,6 +563,27 @@ class SolidSolver : public Mechanics {
     }
   };
 
+  // The mirrored Displacement conditions' layer points from their mirrors' current values
+  // (kernels/boundary_conditions.hpp, mirror_kinematic), after the step has moved the body: the
+  // mirrors' new values reach the ghosts first (one extra refresh per step, only with such
+  // conditions). A corner point's mirror across its condition's face is a point of the
+  // neighbouring layer, read as it stood before any layer was set this step.
+  void mirror_layers(double t) {
+    if (!mirrored_)
+      return;
+    auto& p = disc_.points;
+    disc_.dist.refresh({p.u, p.theta, p.v});
+    if (src_.u.extent(0) == 0)
+      src_ = {Vectors("mupm::mirror_u", p.size(), Dim), Vectors("mupm::mirror_theta", p.size(), R),
+              Vectors("mupm::mirror_v", p.size(), Dim)};
+    Kokkos::deep_copy(src_.u, p.u);
+    Kokkos::deep_copy(src_.theta, p.theta);
+    Kokkos::deep_copy(src_.v, p.v);
+    for (const auto& bc : bcs_)
+      if (bc.kinematic() && bc.mirrored)
+        mirror_kinematic(bc, p, disc_.mirror, src_, t);
+  }
+
   void forces(double t) {
     auto& p = disc_.points;
     if (st_.work == BondWork::Accumulate)
@@ -790,6 +821,8 @@ class SolidSolver : public Mechanics {
   double negative_fraction_ = 0;            // volume fraction with d2E < 0, last window
   double bond_energy_released_ = 0;         // W V_i V_j of the bonds broken since t = 0 [J]
   double broken_pairs_ = 0;                 // bond pairs broken since t = 0 (a restart global)
+  bool mirrored_ = false;                   // mirrored Displacement conditions (mirror_layers)
+  MirrorSources src_;                       // their mirrors' values (mirror_layers)
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
   bool keep_pore_part_ = false;             // P1w for the J-integral (keep_pore_part)
   std::function<Breakage(double)> driver_;  // the J criterion (set_crack_driver), at time t
