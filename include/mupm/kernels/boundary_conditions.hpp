@@ -168,31 +168,27 @@ void apply_kinematic(const std::vector<BoundaryCondition>& bcs, const Points<Dim
 //   theta(i) = det(R) R theta(m): theta_n(i) = theta_n(m), theta_t(i) = -theta_t(m) (an axial
 //   vector; in 2D theta_z lies in the face's plane: theta(i) = -theta(m)),
 // and likewise the velocity v (g' for g); the micro-rotation rate, which is not ghosted, is set
-// to 0 (prescribed components carry no kinetic energy: it is output only). The mirrors' values
-// are read from `src` (u, theta, v as they stood before any layer was set), so that a corner's
-// mirror in the neighbouring layer reads the same on every rank count. Why R and nothing else: the
+// to 0 (prescribed components carry no kinetic energy: it is output only). Only points outside
+// exactly one face (the condition's) are mirrored, so every mirror is a body point, which no
+// mirrored condition writes: the result does not depend on the order of the conditions or on
+// the rank count. Corner (and 3D edge) points and points of the region inside the body are left
+// to apply_kinematic (g on the condition's component) and to other conditions. Why R: the
 // micropolar operator commutes with R (and with -R), so the layered operator stays symmetric and
 // the explicit scheme stable; an odd reflection of the held components alone (-I on u, as the
 // pressure's) is not an invariant subspace, and was measured to grow without bound at any step. R
 // is a symmetry plane (a frictionless roller with theta_t = 0) at u_n = g: exact for fields with
 // that symmetry (a bar stretched along n), not for a clamp (u_t = 0 is not a symmetry of the body);
 // exact for such fields when the layer is 2 delta thick (every layer point bonded to the body then
-// has a whole family). Only points outside exactly one face (the condition's) are mirrored: corner
-// (and 3D edge) points and points of the region inside the body are left to apply_kinematic (g on
-// the condition's component) and to other conditions.
-struct MirrorSources {
-  Vectors u, theta, v;  // owned and ghost points
-};
+// has a whole family).
 template <int Dim>
 void mirror_kinematic(const BoundaryCondition& bc, const Points<Dim>& pts,
-                      const View2<LocalId>& mirror, const MirrorSources& src, double t) {
+                      const View2<LocalId>& mirror, double t) {
   constexpr int R = kRotDim<Dim>;
   const std::uint32_t mask = bc.region_mask;
   const int n = bc.component, col = bc.mirror_column;
   const double g = bc.value * bc.time(t), g_rate = bc.value * bc.time.rate(t);
   auto regions = pts.regions;
   auto u = pts.u, v = pts.v, a = pts.a, th = pts.theta, om = pts.omega, al = pts.alpha;
-  auto us = src.u, vs = src.v, ths = src.theta;
   Kokkos::parallel_for(
       "mupm::BC::mirror_kinematic", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         if (mask != 0 && !(regions(i) & mask))
@@ -201,13 +197,13 @@ void mirror_kinematic(const BoundaryCondition& bc, const Points<Dim>& pts,
           return;
         const LocalId m = mirror(i, col);
         for (int k = 0; k < Dim; ++k) {
-          u(i, k) = k == n ? 2 * g - us(m, k) : us(m, k);
-          v(i, k) = k == n ? 2 * g_rate - vs(m, k) : vs(m, k);
+          u(i, k) = k == n ? 2 * g - u(m, k) : u(m, k);
+          v(i, k) = k == n ? 2 * g_rate - v(m, k) : v(m, k);
           a(i, k) = 0;
         }
         for (int r = 0; r < R; ++r) {
           const double s = (R == 3 && r == n) ? 1.0 : -1.0;
-          th(i, r) = s * ths(m, r);
+          th(i, r) = s * th(m, r);
           om(i, r) = 0;
           al(i, r) = 0;
         }

@@ -566,22 +566,15 @@ class SolidSolver : public Mechanics {
   // The mirrored Displacement conditions' layer points from their mirrors' current values
   // (kernels/boundary_conditions.hpp, mirror_kinematic), after the step has moved the body: the
   // mirrors' new values reach the ghosts first (one extra refresh per step, only with such
-  // conditions). A corner point's mirror across its condition's face is a point of the
-  // neighbouring layer, read as it stood before any layer was set this step.
+  // conditions).
   void mirror_layers(double t) {
     if (!mirrored_)
       return;
     auto& p = disc_.points;
     disc_.dist.refresh({p.u, p.theta, p.v});
-    if (src_.u.extent(0) == 0)
-      src_ = {Vectors("mupm::mirror_u", p.size(), Dim), Vectors("mupm::mirror_theta", p.size(), R),
-              Vectors("mupm::mirror_v", p.size(), Dim)};
-    Kokkos::deep_copy(src_.u, p.u);
-    Kokkos::deep_copy(src_.theta, p.theta);
-    Kokkos::deep_copy(src_.v, p.v);
     for (const auto& bc : bcs_)
       if (bc.kinematic() && bc.mirrored)
-        mirror_kinematic(bc, p, disc_.mirror, src_, t);
+        mirror_kinematic(bc, p, disc_.mirror, t);
   }
 
   void forces(double t) {
@@ -822,7 +815,6 @@ class SolidSolver : public Mechanics {
   double bond_energy_released_ = 0;         // W V_i V_j of the bonds broken since t = 0 [J]
   double broken_pairs_ = 0;                 // bond pairs broken since t = 0 (a restart global)
   bool mirrored_ = false;                   // mirrored Displacement conditions (mirror_layers)
-  MirrorSources src_;                       // their mirrors' values (mirror_layers)
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
   bool keep_pore_part_ = false;             // P1w for the J-integral (keep_pore_part)
   std::function<Breakage(double)> driver_;  // the J criterion (set_crack_driver), at time t
