@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "mupm/kernels/boundary_conditions.hpp"
 #include "test_utils.hpp"
 
 namespace mupm {
@@ -108,6 +109,105 @@ TEST(Distribution, LayerMirrors3D) {
   auto g = test::box<3>({4, 3, 3}, 1.5);
   g.layers = {{{3, 3}, {2, 0}, {0, 2}}};
   check_mirrors(g);
+}
+
+// A mirrored Displacement layer (mirror_kinematic) is the body's mirror image about u_n = g:
+// a field that already has that symmetry about the face (u_n - g odd, u_t even, theta axial:
+// theta_n even, theta_t odd; in 2D theta_z odd) continues into the layer unchanged. The field is
+// set on the body only (the layer poisoned), so a wrong parity or sign of any component, or a
+// wrong mirror, leaves the layer off the field. Face x = hi (3D) or y = lo (2D).
+template <int Dim>
+void check_mirror_image(GridSpec<Dim> g, int axis, int side) {
+  constexpr int R = kRotDim<Dim>;
+  g.mirrored_layers = true;
+  const double face = g.origin[axis] + side * g.counts[axis] * g.dx, gn = 2.5e-3;
+  Box out;  // the layer beyond the face
+  for (int d = 0; d < Dim; ++d) {
+    out.lo[d] = -10;
+    out.hi[d] = 10;
+  }
+  (side ? out.lo : out.hi)[axis] = face + (side ? 0.25 : -0.25) * g.dx;
+  g.regions = {out};
+  auto disc = discretize(test::world(), g);
+  auto& pts = disc.points;
+  // Symmetric about the face: s = x_n - face enters u_n - g and theta_t oddly, the rest evenly.
+  auto field = [&](const double* x, double* u, double* th) {
+    const double s = x[axis] - face;
+    double even = 1;
+    for (int d = 0; d < Dim; ++d)
+      if (d != axis)
+        even += 0.3 * (d + 1) * x[d] + 0.1 * x[d] * x[d];
+    for (int k = 0; k < Dim; ++k)
+      u[k] = k == axis ? gn + s * even + 0.2 * s * s * s : (k + 2) * even + 0.7 * s * s;
+    for (int r = 0; r < R; ++r) {
+      const bool normal = R == 3 && r == axis;
+      th[r] = normal ? 0.4 * even + s * s : (r + 1) * s * even;
+    }
+  };
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.x);
+  auto flags = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.flags);
+  auto u = Kokkos::create_mirror_view(pts.u);
+  auto th = Kokkos::create_mirror_view(pts.theta);
+  auto v = Kokkos::create_mirror_view(pts.v);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    double xi[3] = {0, 0, 0}, ui[3], ti[3];
+    for (int d = 0; d < Dim; ++d)
+      xi[d] = x(i, d);
+    field(xi, ui, ti);
+    const bool layer = flags(i) & kFlagBoundaryLayer;
+    for (int d = 0; d < Dim; ++d)
+      u(i, d) = v(i, d) = layer ? NAN : ui[d];
+    for (int r = 0; r < R; ++r)
+      th(i, r) = layer ? NAN : ti[r];
+  }
+  Kokkos::deep_copy(pts.u, u);
+  Kokkos::deep_copy(pts.theta, th);
+  Kokkos::deep_copy(pts.v, v);
+  BoundaryCondition bc;
+  bc.kind = BoundaryCondition::Displacement;
+  bc.component = axis;
+  bc.value = gn;
+  bc.mirrored = true;
+  bc.region_mask = 1u << 0;
+  bc.mirror_column = axis;
+  mirror_kinematic(bc, pts, disc.mirror, 0.0);
+  Kokkos::deep_copy(u, pts.u);
+  Kokkos::deep_copy(th, pts.theta);
+  Kokkos::deep_copy(v, pts.v);
+  auto m = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.mirror);
+  long long n = 0;
+  for (std::size_t i = 0; i < pts.n_owned; ++i) {
+    if (!(side ? x(i, axis) > face : x(i, axis) < face) || m(i, Dim) < 0)
+      continue;
+    double xi[3] = {0, 0, 0}, ui[3], ti[3];
+    for (int d = 0; d < Dim; ++d)
+      xi[d] = x(i, d);
+    field(xi, ui, ti);
+    for (int d = 0; d < Dim; ++d) {
+      EXPECT_NEAR(u(i, d), ui[d], 1e-12 * (1 + std::abs(ui[d]))) << "point " << i << " u " << d;
+      // v = u on the body and g' = 0, so v_n = -u_n(m) = u_n - 2 g in the layer.
+      const double vn = d == axis ? ui[d] - 2 * gn : ui[d];
+      EXPECT_NEAR(v(i, d), vn, 1e-12 * (1 + std::abs(ui[d]))) << "point " << i << " v " << d;
+    }
+    for (int r = 0; r < R; ++r)
+      EXPECT_NEAR(th(i, r), ti[r], 1e-12 * (1 + std::abs(ti[r]))) << "point " << i << " th " << r;
+    ++n;
+  }
+  long long total = 0;
+  MPI_Allreduce(&n, &total, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_GT(total, 0);
+}
+
+TEST(Distribution, MirroredDisplacementLayerIsMirrorImage2D) {
+  auto g = test::box<2>({6, 7}, 3.015);
+  g.layers = {{{0, 0}, {6, 0}}};
+  check_mirror_image(g, 1, 0);
+}
+
+TEST(Distribution, MirroredDisplacementLayerIsMirrorImage3D) {
+  auto g = test::box<3>({5, 4, 4}, 2.015);
+  g.layers = {{{0, 4}, {0, 0}, {0, 0}}};
+  check_mirror_image(g, 0, 1);
 }
 
 TEST(Distribution, GhostsEqualOwners3D) {
