@@ -80,9 +80,9 @@ double column_u(const BarResult& r, double x, double dx) {
 TEST(SolidSolver, BarUnderTraction) {
   const double dx = 2.5e-3, t = 1e5;
   for (const double factor : {3.015, 4.015}) {
-    auto g = test::box<2>({60, 8}, factor, dx);
+    auto g = test::box<2>({40, 8}, factor, dx);
     g.layers[0] = {g.horizon_cells(), 0};
-    const double L = 60 * dx, H = 8 * dx;
+    const double L = 40 * dx, H = 8 * dx;
     Box left, right;
     left.lo[0] = left.lo[1] = right.lo[1] = -1;
     left.hi[0] = -0.25 * dx;
@@ -99,10 +99,10 @@ TEST(SolidSolver, BarUnderTraction) {
     pull.kind = BoundaryCondition::Traction;
     pull.region_mask = 1u << 1;
     pull.value = t;
-    const auto r = bar_to_rest(g, {hold, pull}, 12000);
+    const auto r = bar_to_rest(g, {hold, pull}, 6000);
     const double E = kLaw.young(), nu = kLaw.poisson();
     const double strain = t * (1 - nu * nu) / E;
-    const double xa = 20.5 * dx, xb = 40.5 * dx, xe = L - 0.5 * dx;
+    const double xa = 10.5 * dx, xb = 30.5 * dx, xe = L - 0.5 * dx;
     const double ua = column_u(r, xa, dx), ub = column_u(r, xb, dx), ue = column_u(r, xe, dx);
     const double measured = (ub - ua) / (xb - xa);
     const double surface_length = (ue - (ub + measured * (xe - xb))) / measured;
@@ -124,10 +124,10 @@ TEST(SolidSolver, BarUnderTraction) {
 // that bonds to the body has a whole family, and its force state is the body's.
 double end_displacement_bar(bool mirrored, int horizons, double& reaction_ratio) {
   const double dx = 2.5e-3, U = 1e-5;
-  auto g = test::box<2>({60, 8}, 3.015, dx);
+  auto g = test::box<2>({40, 8}, 3.015, dx);
   g.layers[0] = {horizons * g.horizon_cells(), horizons * g.horizon_cells()};
   g.mirrored_layers = mirrored;
-  const double L = 60 * dx, H = 8 * dx;
+  const double L = 40 * dx, H = 8 * dx;
   Box left, right;
   left.lo[0] = left.lo[1] = right.lo[1] = -1;
   left.hi[0] = -0.25 * dx;
@@ -143,34 +143,33 @@ double end_displacement_bar(bool mirrored, int horizons, double& reaction_ratio)
   pull.region_mask = 1u << 1;
   pull.value = U;
   pull.time.kind = TimeFunction::Ramp;
-  pull.time.ramp_time = 2e-3;  // about 2000 of the 12000 steps
+  pull.time.ramp_time = 1e-3;  // about 1000 of the 6000 steps
   hold.mirrored = pull.mirrored = mirrored;
-  const auto r = bar_to_rest(g, {hold, pull}, 12000);
+  const auto r = bar_to_rest(g, {hold, pull}, 6000);
   const double E = kLaw.young(), nu = kLaw.poisson();
   const double strain = U / L, stress = E / (1 - nu * nu) * strain;
-  const double xa = 20.5 * dx, xb = 40.5 * dx;
+  const double xa = 10.5 * dx, xb = 30.5 * dx;
   const double measured = (column_u(r, xb, dx) - column_u(r, xa, dx)) / (xb - xa);
   reaction_ratio = -r.reaction / (stress * H * g.thickness);
   return measured / strain;
 }
 
 TEST(SolidSolver, BarUnderEndDisplacement) {
-  double reaction_constant = 0, reaction_thin = 0, reaction_mirrored = 0;
+  // Measured once with one-horizon mirrored layers (L = 60 dx): 1.0053, the layer's outer
+  // points' truncated families (README); not rerun here.
+  double reaction_constant = 0, reaction_mirrored = 0;
   const double constant = end_displacement_bar(false, 1, reaction_constant);
-  const double thin = end_displacement_bar(true, 1, reaction_thin);
   const double mirrored = end_displacement_bar(true, 2, reaction_mirrored);
   RecordProperty("strain_ratio_constant", std::to_string(constant));
-  RecordProperty("strain_ratio_mirrored_1_horizon", std::to_string(thin));
-  RecordProperty("strain_ratio_mirrored_2_horizons", std::to_string(mirrored));
+  RecordProperty("strain_ratio_mirrored", std::to_string(mirrored));
   std::printf(
-      "end displacement: strain ratio %.6f constant, %.6f mirrored (1 horizon), %.6f "
-      "mirrored (2 horizons); reaction ratio %.6f, %.6f, %.6f\n",
-      constant, thin, mirrored, reaction_constant, reaction_thin, reaction_mirrored);
+      "end displacement: strain ratio %.6f constant, %.6f mirrored (2 horizons); "
+      "reaction ratio %.6f, %.6f\n",
+      constant, mirrored, reaction_constant, reaction_mirrored);
   EXPECT_NEAR(mirrored, 1.0, 0.005);
   EXPECT_NEAR(reaction_mirrored, 1.0, 0.005);
-  EXPECT_NEAR(reaction_thin, thin, 1e-3);
   // Constant layers: the body acts longer than L by about 0.7 dx per face (measured 2.3 % at
-  // L = 60 dx); the test pins that they are the worse, as the measurement says.
+  // L = 60 dx, 3.4 % expected at 40 dx); the test pins that they are the worse.
   EXPECT_LT(constant, mirrored);
   EXPECT_NEAR(reaction_constant, constant, 1e-3);  // reaction and strain agree either way
 }
