@@ -440,14 +440,19 @@ struct TerzaghiResult {
 const double kTvs[3] = {0.1, 0.2, 0.5};
 // The column with H = N dx to T_v = 0.1, 0.2, 0.5: the worst |p - p_cf| / p0 beyond `skip`
 // spacings from the drained face, the degree of consolidation U and p at the impervious plane.
-TerzaghiResult solve_terzaghi(int N, bool mirrored, double skip) {
+// The consolidation time t_c = H^2 / c_v is `transits` times the undrained wave's transit time
+// 2H / c_u: the closed form is quasi-static, the column is not (its skeleton lags the load by its
+// inertia and damping), an error that goes as 1 / transits whatever dx (H = 20 dx, mirrored
+// layers, T_v = 0.1: 3.7 % at 400 transits, 0.83 % at 1600; H = 40 dx: 3.0, 1.4, 0.67 % at 400,
+// 800, 1600 transits).
+TerzaghiResult solve_terzaghi(int N, bool mirrored, double skip, double transits = 400) {
   const double* Tvs = kTvs;
   using Result = TerzaghiResult;
   Terzaghi tz;
   tz.N = N;
   tz.H = N * tz.dx;
   tz.transit = 2 * tz.H / tz.c_u;
-  tz.t_c = 400 * tz.transit;
+  tz.t_c = transits * tz.transit;
   tz.c_v = tz.H * tz.H / tz.t_c;
   tz.mobility = tz.c_v * tz.S;
   tz.t_r = 10 * tz.transit;
@@ -491,6 +496,9 @@ TerzaghiResult solve_terzaghi(int N, bool mirrored, double skip) {
 }
 }  // namespace
 
+TEST(Tmp, Tz) {
+  solve_terzaghi(20, false, 2, 1600);
+}
 TEST(HydroMechanical, TerzaghiConsolidation) {
   const double* Tvs = kTvs;
   using Result = TerzaghiResult;
@@ -511,27 +519,22 @@ TEST(HydroMechanical, TerzaghiConsolidation) {
 }
 
 // Mirrored drained layers (Boundary Layer Values = Mirrored: p = -p(mirror) in the layers) put
-// the drained face where it is. The same column with the paper's constant layers and with
-// mirrored ones, errors beyond the first 2 dx: the mirrored layers must at least halve the
-// error at every T_v, and meet the boundary-layer issue's acceptance where this measured it
-// met (max |p - p_cf| / p0 <= 2 % at H = 20 dx and U within 1 % at T_v = 0.2, 0.5; <= 1 % at
-// H = 40 dx and T_v = 0.5). Measured (constant -> mirrored, H = 20 dx): 11.5 -> 3.7 %,
-// 8.0 -> 1.0 %, 6.0 -> 1.1 % at T_v = 0.1, 0.2, 0.5; mirrored at H = 40 dx 3.0, 1.02, 0.75 %.
-// The issue's 2 % / 1 % at T_v = 0.1 and its 1 % at T_v = 0.2, H = 40 dx are not met: those
-// errors barely change with dx (3.7 -> 3.0 %, 0.99 -> 1.02 %), so they are not the face's
-// (left open in the issue).
+// the drained face where it is: the boundary-layer issue's acceptance, max |p - p_cf| / p0 <= 2 %
+// at H = 20 dx and <= 1 % at H = 40 dx beyond the first 2 dx, and U within 1 % at H = 20 dx, at
+// T_v = 0.1, 0.2, 0.5. The column consolidates over 1600 wave transits, so that its inertia and
+// damping (an error of 1 / transits, see solve_terzaghi) stay below the face's error. Measured
+// at T_v = 0.1, 0.2, 0.5 (the paper's constant layers in the same column for comparison: H = 20 dx
+// 10.9, 7.7, 5.6 %, U off by 5.4, 5.7, 5.2 %): H = 20 dx 0.83, 0.39, 0.51 %, U off by 0.06,
+// 0.19, 0.34 %; H = 40 dx 0.67, 0.15, 0.25 %.
 TEST(HydroMechanical, TerzaghiMirroredLayers) {
-  const TerzaghiResult c20 = solve_terzaghi(20, false, 2), r20 = solve_terzaghi(20, true, 2),
-                       r40 = solve_terzaghi(40, true, 2);
+  const TerzaghiResult r20 = solve_terzaghi(20, true, 2, 1600),
+                       r40 = solve_terzaghi(40, true, 2, 1600);
   for (int k = 0; k < 3; ++k) {
     SCOPED_TRACE("T_v = " + std::to_string(kTvs[k]));
-    EXPECT_LT(r20.worst[k], 0.5 * c20.worst[k]);
-    if (k >= 1) {
-      EXPECT_LE(r20.worst[k], 0.02);
-      EXPECT_NEAR(r20.U[k], r20.U_cf[k], 0.01);
-    }
+    EXPECT_LE(r20.worst[k], 0.02);
+    EXPECT_NEAR(r20.U[k], r20.U_cf[k], 0.01);
+    EXPECT_LE(r40.worst[k], 0.01);
   }
-  EXPECT_LE(r40.worst[2], 0.01);
 }
 
 // Solid First and Fluid First are two first-order splittings of the same equations: their
