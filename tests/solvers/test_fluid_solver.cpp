@@ -496,9 +496,6 @@ TerzaghiResult solve_terzaghi(int N, bool mirrored, double skip, double transits
 }
 }  // namespace
 
-TEST(Tmp, Tz) {
-  solve_terzaghi(20, false, 2, 1600);
-}
 TEST(HydroMechanical, TerzaghiConsolidation) {
   const double* Tvs = kTvs;
   using Result = TerzaghiResult;
