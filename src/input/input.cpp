@@ -115,7 +115,11 @@ void bc_template(ParameterList& c) {
         "Pressure [Pa] prescribed on the region's points (a drained boundary; boundaries "
         "without one are impervious), or Fluid Source: water injected at Value [m^3/s; in 2D "
         "m^3/s per metre of thickness] spread over the region's points by volume (a point "
-        "source: a region holding one point; a line: a one-row region; negative: extraction). "
+        "source: a region holding one point; a line: a one-row region; negative: extraction), "
+        "or Fluid Flux: water flowing into the body through a face at Value [m/s] (negative: "
+        "out), on a boundary layer region (e.g. 'Layer -y'): its points outside one face take "
+        "the pressure that continues the body's with the gradient of that flux (README, "
+        "'Boundary layers'). "
         "Fracture (Fracture->Fracture Flow = true): Fracture Pressure [Pa] prescribed on the "
         "region's fracture points, or Fracture Source: water injected into the region's "
         "fracture points at Value [m^3/s; in 2D per metre of thickness] (e.g. at a crack's "
@@ -786,6 +790,13 @@ void check_dimension_arrays(ParameterList& input) {
       throw InputError("Error, " + path_of(c, "Component") + " = " + comp + ": a " +
                        std::to_string(dim) + "D body has components x" +
                        (dim == 3 ? ", y and z." : " and y."));
+    // Fluid Flux sets its layer one way only (the flux's continuation of the body's pressure).
+    if (type == BoundaryCondition::FluidFlux &&
+        c.get<std::string>("Boundary Layer Values") != "Default")
+      throw InputError("Error, " + path_of(c, "Boundary Layer Values") + " = " +
+                       c.get<std::string>("Boundary Layer Values") +
+                       ": a Fluid Flux condition sets its boundary-layer points by the flux (the "
+                       "body's pressure continued with the flux's gradient); leave it Default.");
     // An odd reflection of the held components alone was built and measured unstable (it is not
     // an invariant subspace of the vector operator: Terzaghi's column grew without bound at
     // H = 40 dx). Displacement conditions mirror by the reflection R instead, which the operator
@@ -1314,7 +1325,8 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterLis
       values = input.sublist("Discretization").get<std::string>("Boundary Layer Values");
     // The Discretization's default reaches Pore Pressure only; a Displacement condition mirrors
     // when it says so itself (it then sets every component of its layer: mirror_kinematic).
-    bc.mirrored = (bc.kind == BoundaryCondition::PorePressure && values == "Mirrored") ||
+    bc.mirrored = bc.kind == BoundaryCondition::FluidFlux ||
+                  (bc.kind == BoundaryCondition::PorePressure && values == "Mirrored") ||
                   (bc.kind == BoundaryCondition::Displacement &&
                    c.get<std::string>("Boundary Layer Values") == "Mirrored");
     out.push_back(bc);

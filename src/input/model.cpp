@@ -74,6 +74,7 @@ const Options<BoundaryCondition::Kind>& boundary_condition_options() {
                {"Body Couple", BoundaryCondition::BodyCouple},
                {"Pore Pressure", BoundaryCondition::PorePressure},
                {"Fluid Source", BoundaryCondition::FluidSource},
+               {"Fluid Flux", BoundaryCondition::FluidFlux},
                {"Fracture Pressure", BoundaryCondition::FracturePressure},
                {"Fracture Source", BoundaryCondition::FractureSource}});
   return o;
@@ -159,6 +160,19 @@ void check_mirrored_kinematic(const GridSpec<Dim>& g, const std::vector<Boundary
                          root + "->Boundary Conditions->" + other.name +
                          " also prescribes some of them.");
   }
+}
+
+// A Fluid Flux condition continues the body's pressure across one face (FluidSolver): its
+// region must lie outside exactly one face.
+template <int Dim>
+void check_fluid_flux(const GridSpec<Dim>& g, const std::vector<BoundaryCondition>& bcs,
+                      const std::string& root) {
+  for (const auto& bc : bcs)
+    if (bc.kind == BoundaryCondition::FluidFlux && face_axis(g, bc.region_mask) < 0)
+      throw InputError("Error, " + root + "->Boundary Conditions->" + bc.name +
+                       "->Region: a Fluid Flux condition needs a region that lies outside "
+                       "exactly one face of the body (a boundary layer such as 'Layer -y'): the "
+                       "flux enters through that face.");
 }
 
 template <int Dim>
@@ -280,6 +294,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
   for (const auto& bc : m.boundary_conditions)
     m.grid.mirrored_layers = m.grid.mirrored_layers || bc.mirrored;
   check_mirrored_kinematic(m.grid, m.boundary_conditions, input.name(), r.physics);
+  check_fluid_flux(m.grid, m.boundary_conditions, input.name());
   m.initial_conditions = initial_conditions_from_input(input);
   return m;
 }

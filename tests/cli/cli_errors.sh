@@ -186,6 +186,12 @@ base '<Parameter name="Boundary Layers" type="Array(string)" value="{-x}"/>' \
 sed -n '/<ParameterList name="Boundary Conditions">/,$p' mirrored_kinematic.xml |
   sed 's|value="Velocity"|value="Displacement"|' >>mirrored_fluid.xml
 expect mirrored_fluid 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'mupm->Solver->Physics = Micropolar Solid'
+# Fluid Flux sets its layer by the flux only, and needs a region outside one face.
+sed 's|value="Displacement"|value="Fluid Flux"|' mirrored_fluid.xml >flux_layer_values.xml
+expect flux_layer_values 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'leave it Default'
+sed -e 's|value="Layer -x"|value="All"|' -e '/name="Boundary Layer Values" type="string" value="Mirrored"/d' \
+  flux_layer_values.xml >flux_region.xml
+expect flux_region 2 'mupm->Boundary Conditions->hold->Region' 'outside exactly one face'
 base '' '' | sed 's|value="out"|value="done"|' >done.xml
 run 2 1 done.xml >done.out 2>&1 || { cat done.out; fail "done.xml did not run"; }
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |

@@ -711,3 +711,105 @@ TEST(FluidSolver, HydrostaticInitialStateStaysAtRest) {
 
 }  // namespace
 }  // namespace mupm
+
+namespace mupm {
+namespace {
+
+// Steady Darcy flow through a column (H = 20 dx, 6 wide, impervious sides without layers):
+// water enters through the bottom face at q_n and leaves through a drained top layer
+// (mirrored, p = 0 at the face y = H), so p = (q_n / lambda) (H - y), lambda = k / mu_w. Two
+// ways in: a Fluid Source on the bottom row (q_n W per metre, spread over the row), and a Fluid
+// Flux on a bottom boundary layer (the body's p continued with the flux's gradient). Each starts
+// from the closed form and runs three diffusion times (the state no longer changes).
+// - Both: the far field carries the flux exactly (the mass balance and the nonlocal flux, exact
+//   for a linear field): the source row's distortion decays to 4.8e-4 of p's scale at 2 delta
+//   from the bottom and below 1e-4 beyond 3 delta (asserted there).
+// - The source row: the truncated families at the face distort p within a horizon of it.
+//   Measured: the source row 0.42 % of p(0) = q_n H / lambda above the closed form, the next row
+//   5.4 % below (-1.09 q_n dx / lambda), 0.45 % and 0.2 % below and above on the next two
+//   (H = 20 dx; at 40 dx the same pressures, so half the fractions).
+// - The Fluid Flux layer: exact for a linear field, so p matches the closed form everywhere to
+//   1e-6 of its scale, and the water it lets in is q_n W per metre, booked as its inflow.
+struct FaceInflow {
+  double far = 0, worst = 0, face_row = 0, second_row = 0, inflow_rate = 0;
+};
+FaceInflow face_inflow(bool flux_layer) {
+  const double dx = 0.01, mob = 1e-10, phi = 0.3, Kw = 1e8;
+  const int N = 20, W = 6;
+  const double H = N * dx, q_n = 1e-6, delta = 3.015 * dx;
+  auto g = test::box<2>({W, N}, 3.015, dx);
+  g.layers = {{{0, 0}, {flux_layer ? 6 : 0, 6}}};
+  g.mirrored_layers = true;
+  g.region_names = {"inflow", "drain"};
+  g.regions = {flux_layer ? box2(-1, 2, -1, -0.25 * dx) : box2(-1, 2, 0, dx),
+               box2(-1, 2, H + 0.25 * dx, 2)};
+  auto disc = discretize(test::world(), g);
+  Kokkos::deep_copy(disc.points.porosity, phi);
+  auto exact = [&](double y) { return q_n / mob * (H - y); };
+  set_pressure(disc.points, [&](const double* x) { return exact(x[1]); });
+  auto prm = fluid_params(g, mob, 0.5);
+  prm.bulk_modulus = Kw;
+  BoundaryCondition in, drain;
+  in.name = "inflow";
+  in.kind = flux_layer ? BoundaryCondition::FluidFlux : BoundaryCondition::FluidSource;
+  in.region_mask = 1u;
+  in.value = flux_layer ? q_n : q_n * W * dx;
+  in.mirrored = flux_layer;
+  drain.name = "drain";
+  drain.kind = BoundaryCondition::PorePressure;
+  drain.region_mask = 2u;
+  drain.mirrored = true;
+  FluidSolver<2> fluid(disc, prm, {in, drain}, MPI_COMM_WORLD);
+  fluid.initialize(0, false);
+  const double dt = 0.5 * fluid.estimate_stable_dt();
+  const long steps = long(3 * H * H / (mob * Kw / phi) / dt), tail = steps / 10;
+  double in0 = 0;
+  for (long k = 0; k < steps; ++k) {
+    if (k == steps - tail)
+      in0 = fluid.inflows()[0];
+    fluid.advance(k * dt, dt, 1);
+  }
+  FaceInflow r;
+  r.inflow_rate = (fluid.inflows()[0] - in0) / (tail * dt) / (prm.water_density * g.thickness);
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.x);
+  auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.p);
+  auto flags = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.flags);
+  const double scale = exact(0);
+  double face = 0, second = 0;
+  for (std::size_t i = 0; i < disc.points.n_owned; ++i) {
+    if (flags(i) & kFlagBoundaryLayer)
+      continue;
+    const double y = x(i, 1), e = (p(i) - exact(y)) / scale;
+    r.worst = std::max(r.worst, std::abs(e));
+    if (y > 3 * delta)
+      r.far = std::max(r.far, std::abs(e));
+    if (y < dx)
+      face += e / W;
+    else if (y < 2 * dx)
+      second += e / W;
+  }
+  r.far = global_max(r.far);
+  r.worst = global_max(r.worst);
+  r.face_row = global_sum(face);
+  r.second_row = global_sum(second);
+  if (test::world()->getRank() == 0)
+    std::printf(
+        "[ inflow face ] %s: max |p - p_cf| / p(0) %.2e (beyond 3 delta %.2e), first row %+.4f, "
+        "second row %+.4f, inflow %.6e m/s per unit width (q_n %.6e)\n",
+        flux_layer ? "Fluid Flux layer" : "Fluid Source row", r.worst, r.far, r.face_row,
+        r.second_row, r.inflow_rate / (W * dx), q_n);
+  return r;
+}
+
+TEST(FluidSolver, InflowFaceAgainstDarcy) {
+  const double q_n = 1e-6, width = 6 * 0.01;
+  const FaceInflow row = face_inflow(false), layer = face_inflow(true);
+  EXPECT_LT(row.far, 1e-4);
+  EXPECT_LT(std::abs(row.face_row), 0.01);  // the face's pressure, 0.42 % measured
+  EXPECT_GT(row.worst, 0.01);               // the surface's distortion the layer removes
+  EXPECT_LT(layer.worst, 1e-6);
+  EXPECT_NEAR(layer.inflow_rate, q_n * width, 1e-6 * q_n * width);
+}
+
+}  // namespace
+}  // namespace mupm

@@ -72,6 +72,8 @@ struct BoundaryCondition {
     BodyCouple,
     PorePressure,      // prescribed p [Pa] on the region's points (drained boundary)
     FluidSource,       // water injected [m^3/s; in 2D per metre of thickness], spread by volume
+    FluidFlux,         // water flux into the body through a face [m/s], on its boundary layer:
+                       // the layer continues p with the gradient of that flux (FluidSolver)
     FracturePressure,  // prescribed p_f [Pa] on the region's fracture points
     FractureSource     // water injected into the fracture points of the region [m^3/s; 2D: /m]
   };
@@ -92,7 +94,11 @@ struct BoundaryCondition {
   bool kinematic() const {
     return kind == Displacement || kind == Velocity || kind == MicroRotation;
   }
-  bool fluid() const { return kind == PorePressure || kind == FluidSource || fracture_fluid(); }
+  bool fluid() const {
+    return kind == PorePressure || kind == FluidSource || kind == FluidFlux || fracture_fluid();
+  }
+  // Sets the pressure of its points (Pore Pressure: g; Fluid Flux: the flux's continuation).
+  bool prescribes_pressure() const { return kind == PorePressure || kind == FluidFlux; }
   bool fracture_fluid() const { return kind == FracturePressure || kind == FractureSource; }
   // Bit of Points::fixed this condition prescribes.
   template <int Dim>

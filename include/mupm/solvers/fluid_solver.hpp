@@ -77,6 +77,11 @@ class FluidSolver : public Module {
       if (bc.fluid() && !bc.fracture_fluid())
         bcs_.push_back(bc);
     all_bcs_ = bcs;
+    for (const auto& bc : bcs_)
+      if (bc.mirrored && disc.mirror.extent(0) == 0)
+        throw std::logic_error("FluidSolver: condition '" + bc.name +
+                               "' mirrors its layer, but the grid was built without mirrors "
+                               "(GridSpec::mirrored_layers)");
     auto& p = disc_.points;
     st_.allocate(p.size(), p.n_owned);
     source_ = Scalars("mupm::fluid_source", p.n_owned);
@@ -186,6 +191,15 @@ class FluidSolver : public Module {
               if (mask == 0 || (regions(i) & mask))
                 fixed(i) |= kFixedPressure;
             });
+      if (bcs_[k].kind == BoundaryCondition::FluidFlux) {  // the points it continues p on
+        const auto m = disc_.mirror;
+        const int col = bcs_[k].mirror_column;
+        Kokkos::parallel_for(
+            "mupm::Fluid::mark_flux", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+              if ((mask == 0 || (regions(i) & mask)) && m(i, col) >= 0)
+                fixed(i) |= kFixedPressure;
+            });
+      }
       double v = 0;
       Kokkos::parallel_reduce(
           "mupm::Fluid::region_volume", range(0, p.n_owned),
@@ -344,29 +358,58 @@ class FluidSolver : public Module {
   // p = value g(t) on the points of every pressure condition (later conditions win).
   // `mirror`: the mirrored layer points only (mirrored_), 2 g - p(mirror) (kernels/
   // boundary_conditions.hpp: the mirrors' pressures current on the ghosts); otherwise g on all.
+  // Fluid Flux (mirrored points only): a layer point L whose mirror m lies at Delta = x_L - x_m
+  // (outward, |Delta| = 2d) takes the body's pressure continued with the normal gradient of the
+  // inflow q_in = g(t): Darcy's law (eq 54) q = -lambda (grad p - rho_w g_vec), lambda = k_r k /
+  // mu_w, gives q_in = -q . n = lambda (dp/dn - rho_w g_vec . n), so
+  //   p_L = p_m + |Delta| q_in / lambda_m + rho_w g_vec . Delta   (gravity as in the flow kernel),
+  // with k_r at the mirror's pressure (floored at 1e-6 so that a dry mirror takes a large but
+  // finite pressure). This is the even reflection of p about the face plus the flux's linear
+  // part: exact for any field linear across the face, and a symmetric operator (the even
+  // reflection of a scalar commutes with the lattice's mirror symmetry), so the explicit step
+  // stays stable. The water it lets in is booked as a pressure condition's (the supply below).
   void set_pressure(double t, const Scalars& target, bool mirror = false) {
     auto& p = disc_.points;
     auto regions = p.regions;
     const auto m = disc_.mirror;
     const Bytes only = mirrored_;
     for (const auto& bc : bcs_) {
-      if (bc.kind != BoundaryCondition::PorePressure)
+      if (!bc.prescribes_pressure())
+        continue;
+      const bool flux = bc.kind == BoundaryCondition::FluidFlux;
+      if (flux && !mirror)
         continue;
       const std::uint32_t mask = bc.region_mask;
       const double v = bc.value * bc.time(t);
-      auto pw = p.p;
+      auto pw = p.p, x = p.x;
       const bool reflect = mirror && bc.mirrored;
       const int col = bc.mirror_column;
+      const double k0 = prm_.mobility, rho_w = prm_.water_density;
+      const VanGenuchten vg = prm_.retention;
+      const auto gv = prm_.gravity;
       Kokkos::parallel_for(
           "mupm::Fluid::pressure_bc", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
             if ((mask != 0 && !(regions(i) & mask)) || (mirror && !only(i)))
               return;
-            target(i) = reflect ? 2 * v - pw(m(i, col)) : v;
+            if (!flux) {
+              target(i) = reflect ? 2 * v - pw(m(i, col)) : v;
+              return;
+            }
+            const auto j = m(i, col);
+            double gap2 = 0, grav = 0;
+            for (int d = 0; d < Dim; ++d) {
+              const double delta = x(i, d) - x(j, d);
+              gap2 += delta * delta;
+              grav += rho_w * gv[d] * delta;
+            }
+            const double kr = vg.relative_permeability(vg.saturation(pw(j)));
+            target(i) = pw(j) + std::sqrt(gap2) * v / (k0 * (kr > 1e-6 ? kr : 1e-6)) + grav;
           });
     }
   }
-  // x = -x(mirror) on the mirrored layer points (a perturbation: g = 0), reading the values
-  // from before the update as set_pressure does.
+  // x = -x(mirror) on the mirrored layer points, +x(mirror) on the Fluid Flux ones (a
+  // perturbation: g = 0; the flux's gradient is linear in g), reading the values from before the
+  // update as set_pressure does.
   void mirror_pressure(const Scalars& x) {
     const auto m = disc_.mirror;
     const Bytes only = mirrored_;
@@ -375,16 +418,20 @@ class FluidSolver : public Module {
     Kokkos::parallel_for(
         "mupm::Fluid::mirror_perturbation", range(0, disc_.points.n_owned),
         KOKKOS_LAMBDA(const std::size_t i) {
-          if (only(i))
-            x(i) = -src(m(i, only(i) - 1));
+          const int f = only(i);
+          if (f > kEvenMirror)
+            x(i) = src(m(i, f - 1 - kEvenMirror));
+          else if (f)
+            x(i) = -src(m(i, f - 1));
         });
   }
   // Marks the points whose (last) pressure condition mirrors its layer values (1 + the column of
-  // Discretization::mirror it reflects with); empty if none.
+  // Discretization::mirror it reflects with; + kEvenMirror for Fluid Flux); empty if none.
+  static constexpr int kEvenMirror = 4;
   void mark_mirrored() {
     bool any = false;
     for (const auto& bc : bcs_)
-      any = any || (bc.kind == BoundaryCondition::PorePressure && bc.mirrored);
+      any = any || (bc.prescribes_pressure() && bc.mirrored);
     if (!any)
       return;
     auto& p = disc_.points;
@@ -392,10 +439,13 @@ class FluidSolver : public Module {
     auto regions = p.regions;
     const auto m = disc_.mirror, flag = mirrored_;
     for (const auto& bc : bcs_) {
-      if (bc.kind != BoundaryCondition::PorePressure)
+      if (!bc.prescribes_pressure())
         continue;
       const std::uint32_t mask = bc.region_mask;
-      const int col = bc.mirror_column, on = bc.mirrored ? col + 1 : 0;
+      const int col = bc.mirror_column,
+                on = bc.mirrored
+                         ? col + 1 + (bc.kind == BoundaryCondition::FluidFlux ? kEvenMirror : 0)
+                         : 0;
       Kokkos::parallel_for(
           "mupm::Fluid::mark_mirrored", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
             if (mask == 0 || (regions(i) & mask))
@@ -507,13 +557,13 @@ class FluidSolver : public Module {
     supplied[bcs_.size() + 1] = w[1];
     supplied[bcs_.size() + 2] = w[2];
     for (std::size_t k = 0; k < bcs_.size(); ++k) {
-      if (bcs_[k].kind != BoundaryCondition::PorePressure)
+      if (!bcs_[k].prescribes_pressure())
         continue;
       // Points of several pressure conditions count for the last one (set_pressure's order).
       std::uint32_t later = 0;
       bool later_all = false;
       for (std::size_t l = k + 1; l < bcs_.size(); ++l)
-        if (bcs_[l].kind == BoundaryCondition::PorePressure) {
+        if (bcs_[l].prescribes_pressure()) {
           later |= bcs_[l].region_mask;
           later_all = later_all || bcs_[l].region_mask == 0;
         }
