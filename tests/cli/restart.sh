@@ -81,6 +81,8 @@ check solid inputs/quickstart.xml 40 7
 check coupled inputs/consolidation.xml 60 14
 # Mirrored drained layers: their mirrors' pressures travel with the ghosts.
 check coupled-mirrored inputs/consolidation.xml 60 14 's|<Parameter name="Boundary Layers"|<Parameter name="Boundary Layer Values" type="string" value="Mirrored"/>&|'
+# Water let in through the base by a Fluid Flux layer (after the drained base: it wins there).
+check coupled-flux inputs/consolidation.xml 60 15 's|<ParameterList name="drain top">|<ParameterList name="inflow base"><Parameter name="Type" type="string" value="Fluid Flux"/><Parameter name="Region" type="string" value="Layer -y"/><Parameter name="Value" type="double" value="1e-7"/></ParameterList>\n&|'
 # Mirrored displacement layers (the quick start's plate pulled through mirrored top and bottom
 # layers): the layers follow their mirrors, which travel with the ghosts.
 check solid-mirrored inputs/quickstart.xml 40 7 's|(<Parameter name="Component" type="string" value="y"/>)|\1<Parameter name="Boundary Layer Values" type="string" value="Mirrored"/>|'
