@@ -490,7 +490,8 @@ class FluidSolver : public Module {
     if (fracture_) {
       // The bulk's explicit step without the exchange (p^ of fracture_flow.hpp), then the
       // exchange the fracture step takes, as a sink in the update below. (Mirrored layer
-      // points enter p^ with g, not their mirrored value: layers are far from cracks.)
+      // points enter p^ with g, Fluid Flux ones with 0, not their mirrored value: layers are
+      // far from cracks, and exchange only happens on fracture points.)
       auto phat = phat_, sink = sink_;
       Kokkos::parallel_for(
           "mupm::Fluid::predictor", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
