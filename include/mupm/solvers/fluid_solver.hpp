@@ -185,18 +185,14 @@ class FluidSolver : public Module {
     auto fixed = p.fixed, vol = p.volume;
     for (std::size_t k = 0; k < bcs_.size(); ++k) {
       const std::uint32_t mask = bcs_[k].region_mask;
-      if (bcs_[k].kind == BoundaryCondition::PorePressure)
-        Kokkos::parallel_for(
-            "mupm::Fluid::mark", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-              if (mask == 0 || (regions(i) & mask))
-                fixed(i) |= kFixedPressure;
-            });
-      if (bcs_[k].kind == BoundaryCondition::FluidFlux) {  // the points it continues p on
+      // Pore Pressure holds all its points; Fluid Flux those it continues p on (with a mirror).
+      if (bcs_[k].prescribes_pressure()) {
+        const bool flux = bcs_[k].kind == BoundaryCondition::FluidFlux;
         const auto m = disc_.mirror;
         const int col = bcs_[k].mirror_column;
         Kokkos::parallel_for(
-            "mupm::Fluid::mark_flux", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-              if ((mask == 0 || (regions(i) & mask)) && m(i, col) >= 0)
+            "mupm::Fluid::mark", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+              if ((mask == 0 || (regions(i) & mask)) && (!flux || m(i, col) >= 0))
                 fixed(i) |= kFixedPressure;
             });
       }
