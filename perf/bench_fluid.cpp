@@ -92,8 +92,8 @@ struct CoupledBody {
 
 // The coupled body cut through its middle by a pre-crack (a line across the 2D body, a plane
 // across the 3D one) that carries water: fracture flow on, water injected at the crack's
-// x = 0 edge. The fracture step (gather, assembly, banded solve, scatter), the exchange and
-// the crack water's face forces come on top of the coupled step.
+// x = 0 edge. The fracture step (gather, assembly, sparse Cholesky solve, scatter), the exchange
+// and the crack water's face forces come on top of the coupled step.
 template <int Dim>
 struct FractureBody {
   static constexpr int dim = Dim;
@@ -218,7 +218,7 @@ void BM_CoupledStepWithFractureFlow(benchmark::State& state) {
   }
   counters(state, b);
   state.counters["fracture_points"] = double(b.fluid->fracture_flow()->network_size());
-  state.counters["bandwidth"] = double(b.fluid->fracture_flow()->last_bandwidth());
+  state.counters["factor_nnz"] = b.fluid->fracture_flow()->last_factor_nnz();
 }
 
 // UseRealTime: wall clock (see perf/bench_solid.cpp).

@@ -5,8 +5,10 @@
 // crack's water pushes each face with p_f per unit area.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 #include <vector>
 
 #include "mupm/input/model.hpp"
@@ -14,6 +16,7 @@
 #include "mupm/solvers/damage.hpp"
 #include "mupm/solvers/fluid_solver.hpp"
 #include "mupm/solvers/solid_solver.hpp"
+#include "mupm/solvers/sparse_cholesky.hpp"
 #include "test_utils.hpp"
 
 namespace mupm {
@@ -91,6 +94,71 @@ double sum_owned(const Points<2>& p, F&& f) {
     s += f(i);
   MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   return s;
+}
+
+// The network's direct solve (include/mupm/solvers/sparse_cholesky.hpp) on the shape of its
+// systems: a chain of n points with storage s and conductance c to the next two, in a
+// scrambled numbering (so the ordering matters), against the residual A x - b computed here;
+// and a singular matrix is reported, not solved.
+TEST(FractureFlow, SparseCholeskySolvesTheNetworkSystem) {
+  const int n = 300;
+  const double s = 1e-6, c = 1.0;  // conductances 1e6 times the storage, as along an open crack
+  std::vector<int> id(n);
+  for (int k = 0; k < n; ++k)
+    id[k] = int((7L * k) % n);                               // 7 and 300 coprime: a permutation
+  std::vector<std::vector<std::pair<int, double>>> cols(n);  // lower triangle by column
+  std::vector<double> diag(n, s);
+  for (int k = 0; k < n; ++k)
+    for (int step = 1; step <= 2; ++step)
+      if (k + step < n) {
+        const int a = id[k], b = id[k + step];
+        cols[std::min(a, b)].push_back({std::max(a, b), -c});
+        diag[a] += c;
+        diag[b] += c;
+      }
+  LowerCsc m;
+  m.n = n;
+  m.first.assign(1, 0);
+  for (int j = 0; j < n; ++j) {
+    std::sort(cols[j].begin(), cols[j].end());
+    m.row.push_back(j);
+    m.value.push_back(diag[j]);
+    for (const auto& [r, v] : cols[j]) {
+      m.row.push_back(r);
+      m.value.push_back(v);
+    }
+    m.first.push_back(int(m.row.size()));
+  }
+  std::vector<double> b(n), x;
+  for (int k = 0; k < n; ++k)
+    b[k] = std::sin(0.1 * k) + (k == id[0] ? 1.0 : 0.0);
+  x = b;
+  const CholeskyResult r = solve_spd(m, x);
+  ASSERT_TRUE(r.ok);
+  EXPECT_GE(r.factor_nnz, double(n));
+  // Residual with the full symmetric matrix, relative to the largest term of a row.
+  std::vector<double> ax(n, 0.0);
+  for (int j = 0; j < n; ++j)
+    for (int e = m.first[j]; e < m.first[j + 1]; ++e) {
+      const int i = m.row[e];
+      ax[i] += m.value[e] * x[j];
+      if (i != j)
+        ax[j] += m.value[e] * x[i];
+    }
+  double worst = 0, xmax = 0;
+  for (int k = 0; k < n; ++k)
+    xmax = std::max(xmax, std::abs(x[k]));
+  for (int k = 0; k < n; ++k)
+    worst = std::max(worst, std::abs(ax[k] - b[k]) / (diag[k] * xmax));
+  EXPECT_LT(worst, 1e-12);
+  // A singular matrix (two points joined without storage: pivots 1 and exactly 0).
+  LowerCsc z;
+  z.n = 2;
+  z.first = {0, 2, 3};
+  z.row = {0, 1, 1};
+  z.value = {1.0, -1.0, 1.0};
+  std::vector<double> y = {1.0, 0.0};
+  EXPECT_FALSE(solve_spd(z, y).ok);
 }
 
 // A slot of aperture a between an inlet held at p1 and an outlet at 0, impervious bulk: at

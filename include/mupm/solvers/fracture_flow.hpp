@@ -38,10 +38,10 @@
 // The network is small (the fracture points of a 2D body lie on lines, of a 3D body on
 // surfaces): every rank gathers it whole (its points' positions, apertures, normals, bulk
 // state and neighbour ids), assembles the same symmetric, diagonally dominant system in
-// global-id order and solves it directly (banded LU in reverse Cuthill-McKee order), serially.
-// Every rank gets the same bits whatever the number of ranks or threads, and the ghosts get
-// their p_f without an exchange. A singular system stops the run (CollectiveError), never a
-// silent garbage p_f.
+// global-id order and solves it directly (sparse Cholesky,
+// include/mupm/solvers/sparse_cholesky.hpp), serially. Every rank gets the same bits whatever the
+// number of ranks or threads, and the ghosts get their p_f without an exchange. A singular system
+// stops the run (CollectiveError), never a silent garbage p_f.
 //
 // Water content: each fracture point's content grows by what flowed in over the step,
 //   dt (sum_j Lambda_ij (p_j - p_i) + Q_i) + X_i,
@@ -61,9 +61,8 @@
 #include <limits>
 #include <numeric>
 #include <string>
+#include <utility>
 #include <vector>
-
-#include <Teuchos_LAPACK.hpp>
 
 #include "mupm/core/error.hpp"
 #include "mupm/kernels/boundary_conditions.hpp"
@@ -72,6 +71,7 @@
 #include "mupm/kernels/fracture_flow.hpp"
 #include "mupm/mesh/discretization.hpp"
 #include "mupm/solvers/module.hpp"
+#include "mupm/solvers/sparse_cholesky.hpp"
 
 namespace mupm {
 
@@ -96,7 +96,8 @@ class FractureFlow {
   std::vector<double>& inflows() { return inflow_; }
   const std::vector<double>& inflows() const { return inflow_; }
   long long network_size() const { return last_size_; }
-  int last_bandwidth() const { return last_bandwidth_; }
+  // Non-zeros of the last factorization's L (its fill), for the benchmarks.
+  double last_factor_nnz() const { return last_factor_nnz_; }
 
   // Water in the fracture spaces [kg]: rho_w sum_i V_i content_i.
   double mass() const {
@@ -330,93 +331,65 @@ class FractureFlow {
       rhs_[i] += source_[i];
   }
 
-  // The free rows' system, the held values moved to the right-hand side, by a banded LU
-  // (LAPACK GBTRF/GBTRS through Teuchos) in reverse Cuthill-McKee order: the network is a band
-  // of points along the crack, so its bandwidth stays of the order of the points within a
-  // horizon. Direct, as the conductances along an open crack exceed the storage by many orders
-  // (an iterative solver would need a condition-number-dependent number of iterations).
+  // The free rows' system, the held values moved to the right-hand side, solved directly by a
+  // sparse Cholesky factorization (include/mupm/solvers/sparse_cholesky.hpp): the system is
+  // symmetric (lambda_ij = lambda_ji) and strictly diagonally dominant with a positive diagonal,
+  // hence positive definite. Direct, as the conductances along an open crack exceed the storage
+  // by many orders (an iterative solver would need a condition-number-dependent number of
+  // iterations). Free rows keep the global-id order, so every rank factors the same matrix.
   void solve() {
     const int n = int(gid_.size());
     x_.assign(n, 0.0);
-    std::vector<int> pos(n, -1), order;  // position of a free row in the band order
-    for (int i = 0; i < n; ++i)
+    std::vector<int> pos(n, -1);  // column of a free row
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
       if (held_[i] >= 0)
         x_[i] = held_value_[i];
-    // Reverse Cuthill-McKee over the free rows, component by component, from a free row of
-    // least degree (lowest global id among equals): the same order on every rank.
-    std::vector<int> degree(n, 0);
-    for (int i = 0; i < n; ++i)
-      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
-        degree[i] += held_[adj_[e]] < 0 ? 1 : 0;
-    std::vector<char> seen(n, 0);
-    for (;;) {
-      int start = -1;
-      for (int i = 0; i < n; ++i)
-        if (held_[i] < 0 && !seen[i] && (start < 0 || degree[i] < degree[start]))
-          start = i;
-      if (start < 0)
-        break;
-      std::size_t head = order.size();
-      order.push_back(start);
-      seen[start] = 1;
-      while (head < order.size()) {
-        const int i = order[head++];
-        std::vector<int> next;
-        for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e) {
-          const int j = adj_[e];
-          if (held_[j] < 0 && !seen[j]) {
-            seen[j] = 1;
-            next.push_back(j);
-          }
-        }
-        std::stable_sort(next.begin(), next.end(),
-                         [&](int a, int b) { return degree[a] < degree[b]; });
-        order.insert(order.end(), next.begin(), next.end());
-      }
+      else
+        pos[i] = m++;
     }
-    std::reverse(order.begin(), order.end());
-    const int m = int(order.size());
     if (m == 0)
       return;
-    for (int k = 0; k < m; ++k)
-      pos[order[k]] = k;
-    int kd = 0;
-    for (int i = 0; i < n; ++i)
-      if (pos[i] >= 0)
-        for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
-          if (pos[adj_[e]] >= 0)
-            kd = std::max(kd, std::abs(pos[i] - pos[adj_[e]]));
-    const int ldab = 3 * kd + 1;  // GBTRF's band storage: kl = ku = kd, plus kd for the fill
-    std::vector<double> ab(std::size_t(ldab) * m, 0.0), b(m);
-    auto at = [&](int r, int c) -> double& { return ab[std::size_t(c) * ldab + 2 * kd + r - c]; };
+    LowerCsc a;
+    a.n = m;
+    a.first.assign(1, 0);
+    std::vector<double> b(m);
+    std::vector<std::pair<int, double>> col;
     for (int i = 0; i < n; ++i) {
       if (pos[i] < 0)
         continue;
       double rhs = rhs_[i];
-      at(pos[i], pos[i]) += diag_[i];
+      col.assign(1, {pos[i], diag_[i]});
       for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e) {
         const int j = adj_[e];
-        if (pos[j] >= 0)
-          at(pos[i], pos[j]) -= lambda_[e];
-        else
+        if (pos[j] < 0)
           rhs += lambda_[e] * x_[j];  // a held neighbour
+        else if (pos[j] > pos[i])
+          col.push_back({pos[j], -lambda_[e]});
       }
+      std::sort(col.begin() + 1, col.end());
+      for (const auto& [row, v] : col) {
+        a.row.push_back(row);
+        a.value.push_back(v);
+      }
+      a.first.push_back(int(a.row.size()));
       b[pos[i]] = rhs;
     }
-    Teuchos::LAPACK<int, double> lapack;
-    std::vector<int> ipiv(m);
-    int info = 0;
-    lapack.GBTRF(m, m, kd, kd, ab.data(), ldab, ipiv.data(), &info);
-    if (info == 0)
-      lapack.GBTRS('N', m, kd, kd, 1, ab.data(), ldab, ipiv.data(), b.data(), m, &info);
-    if (info != 0)
-      throw CollectiveError("Error, the fracture-pressure system of " + std::to_string(m) +
-                            " fracture points is singular (LAPACK GBTRF/GBTRS info " +
-                            std::to_string(info) + ").");
+    const CholeskyResult res = solve_spd(a, b);
+    bool finite = res.ok;
+    for (int k = 0; finite && k < m; ++k)
+      finite = std::isfinite(b[k]);
+    if (!finite)
+      throw CollectiveError(
+          "Error, the fracture-pressure system of " + std::to_string(m) +
+          " fracture points could not be solved (" +
+          (res.ok ? std::string("non-finite solution")
+                  : "factorization stopped at column " + std::to_string(res.failed_column)) +
+          ").");
     for (int i = 0; i < n; ++i)
       if (pos[i] >= 0)
         x_[i] = b[pos[i]];
-    last_bandwidth_ = kd;
+    last_factor_nnz_ = res.factor_nnz;
   }
 
   // The new p_f, S_rf, rates and contents onto the local points, the exchange into `sink`,
@@ -474,7 +447,7 @@ class FractureFlow {
       held_value_;
   std::vector<int> adj_, held_, rows_;
   long long last_size_ = 0;
-  int last_bandwidth_ = 0;
+  double last_factor_nnz_ = 0;
 };
 
 }  // namespace mupm
