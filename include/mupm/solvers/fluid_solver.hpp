@@ -348,7 +348,32 @@ class FluidSolver : public Module {
     auto& p = disc_.points;
     fluid_constitutive(p, prm_, st_);
     disc_.dist.refresh({as_vectors(p.p)});
+    mirror_rel_perm();
     fluid_flow(disc_, prm_, st_, p.p);
+  }
+
+  // The mirrored layer points (Pore Pressure and Fluid Flux, mirrored_) take their mirror's k_r
+  // (from its pressure, current on the ghosts): the layer is the mirror image of the medium, as
+  // its pressures are of the body's. With the layer's own k_r(p_L) the conductances across the
+  // face are not the body's: in unsaturated flow, where k_r changes by orders of magnitude over
+  // a horizon, a Fluid Flux face let in 5.4 % more than q_n (1.27 instead of 1.82 q_n in a
+  // harsher column), FluidSolver.InflowFaceWithGravityAndUnsaturated. Saturated, k_r = 1 on both.
+  void mirror_rel_perm() {
+    if (mirrored_.extent(0) == 0)
+      return;
+    auto kr = disc_.points.rel_perm, pw = disc_.points.p;
+    const auto m = disc_.mirror;
+    const Bytes only = mirrored_;
+    const VanGenuchten vg = prm_.retention;
+    Kokkos::parallel_for(
+        "mupm::Fluid::mirror_rel_perm", range(0, disc_.points.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i) {
+          const int f = only(i);
+          if (!f)
+            return;
+          const int col = f > kEvenMirror ? f - 1 - kEvenMirror : f - 1;
+          kr(i) = vg.relative_permeability(vg.saturation(pw(m(i, col))));
+        });
   }
 
   // p = value g(t) on the points of every pressure condition (later conditions win).
