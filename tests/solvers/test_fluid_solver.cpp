@@ -780,7 +780,8 @@ FaceInflow face_inflow(const InflowCase& c) {
     table[k - 1] = p - h * (k1 + 2 * k2 + 2 * k3 + k4) / 6;
   }
   auto exact = [&](double y) {
-    if (c.suction == 0 || y > H || y < 0)  // linear (saturated); the layers by extrapolation
+    // Saturated: the line. Outside [0, H] (the layers, which the conditions overwrite): the line.
+    if (c.suction == 0 || y > H || y < 0)
       return (q_n / mob + rho_g) * (H - y) - c.suction;
     const int k = std::min(int(y / h), fine - 1);
     const double f = y / h - k;

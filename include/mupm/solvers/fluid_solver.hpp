@@ -372,8 +372,7 @@ class FluidSolver : public Module {
           const int f = only(i);
           if (!f)
             return;
-          const int col = f > kEvenMirror ? f - 1 - kEvenMirror : f - 1;
-          kr(i) = vg.relative_permeability(vg.saturation(pw(m(i, col))));
+          kr(i) = vg.relative_permeability(vg.saturation(pw(m(i, mirror_column(f)))));
         });
   }
 
@@ -441,15 +440,19 @@ class FluidSolver : public Module {
         "mupm::Fluid::mirror_perturbation", range(0, disc_.points.n_owned),
         KOKKOS_LAMBDA(const std::size_t i) {
           const int f = only(i);
-          if (f > kEvenMirror)
-            x(i) = src(m(i, f - 1 - kEvenMirror));
-          else if (f)
-            x(i) = -src(m(i, f - 1));
+          if (!f)
+            return;
+          const double v = src(m(i, mirror_column(f)));
+          x(i) = f > kEvenMirror ? v : -v;
         });
   }
   // Marks the points whose (last) pressure condition mirrors its layer values (1 + the column of
   // Discretization::mirror it reflects with; + kEvenMirror for Fluid Flux); empty if none.
   static constexpr int kEvenMirror = 4;
+  // The column of Discretization::mirror that a non-zero mark of mark_mirrored() reflects with.
+  static KOKKOS_INLINE_FUNCTION int mirror_column(int f) {
+    return f > kEvenMirror ? f - 1 - kEvenMirror : f - 1;
+  }
   void mark_mirrored() {
     bool any = false;
     for (const auto& bc : bcs_)
