@@ -136,7 +136,6 @@ struct FractureBody {
     typename SolidSolver<Dim>::Settings set;
     set.fracture.flow = true;
     set.fracture.min_aperture = 1e-4;
-    set.fracture.crossing_measure = crossing_measure<Dim>(g.horizon, g.thickness);
     BoundaryCondition inject;
     inject.kind = BoundaryCondition::FractureSource;
     inject.name = "inject";

@@ -263,7 +263,6 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.fracture.viscosity = fluid.get<double>("Viscosity");
   m.fracture.min_aperture = fracture.get<double>("Minimum Aperture");
   m.fracture.water_modulus = m.fluid.bulk_modulus;
-  m.fracture.crossing_measure = crossing_measure<Dim>(m.grid.horizon, m.grid.thickness);
   m.fracture.face_pressure =
       crack_water_force_options()(fracture.get<std::string>("Crack Water Force")) ==
       CrackWaterForce::FacePressure;

@@ -60,6 +60,7 @@ struct Points {
   Scalars pf_content;     // water that entered the point's fracture space, per unit volume
   Scalars pf_aperture;    // mean opening c_f at the last fracture-flow step (volume change)
   Scalars pf_modulus;     // M_f [Pa/m]: p_f* = p_f - M_f (c_f - pf_aperture) (undrained split)
+  Scalars pf_area;        // A_i = V_i / (n_i dx): the point's share of the crack's face area
   Scalars porosity, saturation;
   Scalars rel_perm;             // relative permeability k_r (eq 56)
   Vectors darcy_flux;           // q [m/s] (eq 54) [n][Dim]
@@ -179,6 +180,7 @@ struct Points {
     f(p.pf_content,        FieldSpec{"fracture_fluid_content", 1, kState});
     f(p.pf_aperture,       FieldSpec{"fracture_storage_aperture", 1, kCheckpoint});
     f(p.pf_modulus,        FieldSpec{"fracture_undrained_modulus", 1, kCheckpoint});
+    f(p.pf_area,           FieldSpec{"fracture_face_area", 1, kCheckpoint});
     f(p.porosity,          FieldSpec{"porosity", 1, kState, "Porosity"});
     f(p.saturation,        FieldSpec{"saturation", 1, kState, "Saturation"});
     f(p.rel_perm,          FieldSpec{"relative_permeability", 1, kState});

@@ -46,7 +46,6 @@ struct FractureParams {
   double min_aperture = 1e-6;    // lower bound of the aperture in conductance and storage [m]
   double water_modulus = 2.2e9;  // K_w [Pa] (Fluid->Fluid Bulk Modulus): the crack water's
                                  // stiffness in the solid's stable-step estimate
-  double crossing_measure = 0;   // m_c of the crack-pressure force (crossing_measure<Dim>)
   bool face_pressure = true;     // p_f on the crack's faces (true) or on fracture bonds (eq 17)
 };
 

@@ -129,9 +129,16 @@ class FluidSolver : public Module {
     g("dissipation", energy_.dissipation);
     g("external_work", energy_.external_work);
     g("fluid_mass_initial", mass0_);
-    if (fracture_)
+    if (fracture_) {
       for (std::size_t k = 0; k < fracture_->conditions().size(); ++k)
         g("inflow_" + fracture_->conditions()[k].name, fracture_->inflows()[k]);
+      auto& fe = fracture_->energy();
+      g("fracture_stored_energy", fe.stored);
+      g("fracture_skeleton_work", fe.skeleton_work);
+      g("fracture_dissipation", fe.dissipation);
+      g("fracture_external_work", fe.external_work);
+      g("fracture_exchange_work", fe.exchange_work);
+    }
   }
   void series(SeriesRow& row) const override {
     const auto e = energy();
@@ -155,6 +162,13 @@ class FluidSolver : public Module {
         row("fluid_inflow_" + fracture_->conditions()[k].name, fracture_->inflows()[k]);
         supplied += fracture_->inflows()[k];
       }
+      const auto& fe = fracture_->energy();  // include/mupm/solvers/fracture_flow.hpp header
+      row("fracture_fluid_stored_energy", fe.stored);
+      row("fracture_fluid_skeleton_work", fe.skeleton_work);
+      row("fracture_fluid_dissipation", fe.dissipation);
+      row("fracture_fluid_external_work", fe.external_work);
+      row("fracture_fluid_exchange_work", fe.exchange_work);
+      row("fracture_fluid_energy_error", fe.balance());
     }
     // Water conservation [kg]: bulk + fracture - initial - everything that entered.
     row("fluid_mass_error", (bulk + fracture - mass0_) - supplied);
@@ -172,7 +186,22 @@ class FluidSolver : public Module {
     b.supplied_expression = "|E_s0| + |W_c| + |W_ext|";
     b.supplied = std::abs(e.stored0) + std::abs(e.coupling_work) + std::abs(e.external_work);
     b.field = "pore_pressure";
-    return {b};
+    if (!fracture_)
+      return {b};
+    // The crack water's balance (include/mupm/solvers/fracture_flow.hpp header).
+    const auto& fe = fracture_->energy();
+    EnergyBalance f;
+    f.what = "fracture fluid";
+    f.expression = "E_f - E_f0 + W_sk + D_f - W_ext,f - W_x";
+    f.error = std::abs(fe.balance());
+    f.scale = fe.scale();
+    f.stored_expression = "|E_f - E_f0|";
+    f.stored = std::abs(fe.stored);
+    f.supplied_expression = "|W_ext,f| + |W_x| + |W_sk|";
+    f.supplied =
+        std::abs(fe.external_work) + std::abs(fe.exchange_work) + std::abs(fe.skeleton_work);
+    f.field = "fracture_pressure";
+    return {b, f};
   }
   const std::vector<double>& inflows() const { return inflow_; }
 

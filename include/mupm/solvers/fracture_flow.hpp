@@ -51,6 +51,27 @@
 // (becomes a fracture point) with p_f = its bulk p_w, no content and phi_f^n = its phi_f: the
 // crack's volume at joining is taken as filled at that pressure (not booked as water), its
 // opening from then on is.
+//
+// Energy of the crack water (issue 9 item 5; the fracture's analogue of eqs 147-149). Multiplying
+// each point's content equation above by the step's mean pressure p_m = (p_i^n + p_i)/2 and
+// summing over the network gives, per step,
+//   sum V C_f (p - p^n) p_m + sum V S_rf dphi_f p_m
+//     = -D + sum p_m dt Q + sum p_m X + sum p_m (reservoir supply),
+//   D = -dt sum_i p_m,i sum_j Lambda_ij (p_j - p_i) = dt sum_pairs Lambda_ij (p_j - p_i)(p_m,j -
+//   p_m,i),
+// booked as: stored energy sum V phi_f [psi(p) - psi(p^n)] (psi the bulk's stored energy per
+// unit pore volume, include/mupm/kernels/fluid.hpp, at phi = 1: the first term when C_f is
+// constant), the work on the skeleton W_sk = sum V S_rf dphi_f p_m (what the crack's opening
+// takes from the water: the solid books the same work as its face forces' work,
+// SolidSolver::Energy::crack_work), the flow dissipation D, the external work W_ext (sources
+// and prescribed p_f, at p_m: second order in dt) and the exchange W_x (the bulk's water
+// entering at p_m; the bulk books it at its own pressure, fluid_solver.hpp, the difference is
+// the exchange's dissipation). Their balance E - E_0 + W_sk + D - W_ext - W_x is zero to
+// round-off for saturated crack water (C_f = phi_f / K_w constant over the step: psi's change is
+// then exactly C_f (p - p^n) p_m), as the water mass is; it checks the bookkeeping and the
+// linear solve, and for unsaturated crack water measures the step's linearization of C_f (taken
+// at p^n). The crack's volume at joining is not booked (as its water is not); neither is the
+// capillary energy psi dphi_f of the space an opening adds at fixed p (zero when saturated).
 #ifndef MUPM_SOLVERS_FRACTURE_FLOW_HPP
 #define MUPM_SOLVERS_FRACTURE_FLOW_HPP
 
@@ -98,6 +119,21 @@ class FractureFlow {
   long long network_size() const { return last_size_; }
   // Non-zeros of the last factorization's L (its fill), for the benchmarks.
   double last_factor_nnz() const { return last_factor_nnz_; }
+
+  // The crack water's energy terms since t = 0 [J] (header), the same on every rank.
+  struct Energy {
+    double stored = 0, skeleton_work = 0, dissipation = 0, external_work = 0, exchange_work = 0;
+    double balance() const {
+      return stored + skeleton_work + dissipation - external_work - exchange_work;
+    }
+    double scale() const {
+      return std::max(std::max(std::abs(stored), std::abs(skeleton_work)),
+                      std::max(std::abs(dissipation),
+                               std::max(std::abs(external_work), std::abs(exchange_work))));
+    }
+  };
+  Energy& energy() { return energy_; }
+  const Energy& energy() const { return energy_; }
 
   // Water in the fracture spaces [kg]: rho_w sum_i V_i content_i.
   double mass() const {
@@ -223,6 +259,7 @@ class FractureFlow {
     adj_.clear();
     std::vector<double> kappa(n, 0.0);
     storage_.assign(n, 0.0);
+    phi_f_.assign(n, 0.0);
     opening_.assign(n, 0.0);
     rows_.assign(n, 1);
     gexch_.assign(n, 0.0);
@@ -257,6 +294,7 @@ class FractureFlow {
       kappa[i] = m > 0 ? a * a * a * area / (6.0 * mu * m) : 0.0;     // kernels header
       const double film = std::max(amin + r(i, kOpen), 0.01 * amin);  // header
       const double phi_f = film / (rows * dx);
+      phi_f_[i] = phi_f;
       const double pold = r(i, kPold), sat = vg.saturation(pold);
       storage_[i] = phi_f * (vg.dsaturation_dp(pold) + sat * inv_kw);
       opening_[i] = sat * (r(i, kOpen) - r(i, kOpenRef)) / (rows * dx);  // S_rf d(phi_f)
@@ -400,19 +438,35 @@ class FractureFlow {
     const VanGenuchten vg = fluid_.retention;
     std::vector<double> supplied(bcs_.size(), 0.0);
     std::vector<double> gain(n), exch(n);
+    const double inv_kw = 1.0 / fluid_.bulk_modulus;
+    Energy de;  // this step's terms (header), summed in global-id order on every rank
     for (int i = 0; i < n; ++i) {
       double flow = 0;
       for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
         flow += lambda_[e] * (x_[adj_[e]] - x_[i]);
-      const double v = r(i, kVol);
+      const double v = r(i, kVol), pold = r(i, kPold);
+      const double pm = 0.5 * (pold + x_[i]);
       exch[i] = dt * v * gexch_[i] * (r(i, kPhat) - x_[i]);
       gain[i] = dt * (flow + source_[i]) + exch[i];
+      de.stored += v * phi_f_[i] *
+                   (stored_energy_density(vg, 1.0, inv_kw, x_[i]) -
+                    stored_energy_density(vg, 1.0, inv_kw, pold));
+      de.skeleton_work += pm * v * opening_[i];
+      de.dissipation -= pm * dt * flow;
+      de.external_work += pm * dt * source_[i];
+      de.exchange_work += pm * exch[i];
       if (held_[i] >= 0) {
-        const double stored = v * (storage_[i] * (x_[i] - r(i, kPold)) + opening_[i]);
+        const double stored = v * (storage_[i] * (x_[i] - pold) + opening_[i]);
         supplied[held_[i]] += stored - gain[i];
+        de.external_work += pm * (stored - gain[i]);
         gain[i] = stored;
       }
     }
+    energy_.stored += de.stored;
+    energy_.skeleton_work += de.skeleton_work;
+    energy_.dissipation += de.dissipation;
+    energy_.external_work += de.external_work;
+    energy_.exchange_work += de.exchange_work;
     for (std::size_t k = 0; k < bcs_.size(); ++k)
       inflow_[k] += fluid_.water_density * supplied[k];
     for (std::size_t i = 0; i < p.size(); ++i) {
@@ -423,6 +477,7 @@ class FractureFlow {
         p.pf_rate(i) = (x_[k] - r(k, kPold)) / dt;
         p.pf_content(i) += gain[k] / r(k, kVol);
         p.pf_aperture(i) = r(k, kOpen);
+        p.pf_area(i) = r(k, kVol) / (rows_[k] * disc_.grid.dx);  // A_i (kernels header)
         // The undrained modulus M_f = S_rf/(C_f n_i dx) of the solid's p_f* (kernels header):
         // 0 on a point of prescribed p_f.
         p.pf_modulus(i) =
@@ -443,11 +498,12 @@ class FractureFlow {
   std::vector<double> inflow_;
   // The gathered network (global-id order) and its system.
   std::vector<long long> gid_, nb_, nb_first_, adj_first_;
-  std::vector<double> rec_, lambda_, diag_, rhs_, source_, storage_, opening_, gexch_, x_,
+  std::vector<double> rec_, lambda_, diag_, rhs_, source_, storage_, phi_f_, opening_, gexch_, x_,
       held_value_;
   std::vector<int> adj_, held_, rows_;
   long long last_size_ = 0;
   double last_factor_nnz_ = 0;
+  Energy energy_;
 };
 
 }  // namespace mupm

@@ -72,6 +72,10 @@ class SolidSolver : public Mechanics {
     // (the -S_r p* 1 part of the total stress, eq 46; p* linear in tr eps within a step, so the
     // trapezoid rule is exact).
     double pore_work = 0;
+    // The part of external_work done by the crack water's face forces (Fracture Flow with the
+    // face pressure): the solid's side of the crack water's work on the skeleton, which the
+    // fracture network books as Sigma V p_f S_rf dphi_f (solvers/fracture_flow.hpp).
+    double crack_work = 0;
     // E_int + E_kin + D - W_ext - W_pore, which the scheme keeps constant (eq 140).
     double balance() const {
       return internal + kinetic + dissipation + fracture + plastic - external_work - pore_work;
@@ -100,7 +104,8 @@ class SolidSolver : public Mechanics {
     body_ = Vectors("mupm::body_force", p.n_owned, Dim);
     if (face_pressure()) {
       crack_ = Vectors("mupm::crack_force", p.n_owned, Dim);
-      pf_star_ = Scalars("mupm::undrained_fracture_pressure", p.size());
+      pf_star_ = Scalars("mupm::undrained_fracture_pressure", p.n_owned);
+      face_load_ = Vectors("mupm::crack_face_load", p.size(), Dim);
     }
     if (set_.fracture.flow && !set_.fracture.face_pressure)  // eq 17 (kernels/solid.hpp)
       st_.allocate_eq17(p.size(), p.n_owned);
@@ -141,6 +146,8 @@ class SolidSolver : public Mechanics {
     g("dissipation", dissipation_);
     g("pore_pressure_work", pore_work_);
     g("initial_balance", balance0_);
+    if (face_pressure())
+      g("crack_force_work", crack_work_);
     if (breaks()) {
       g("fracture_energy", fracture_energy_);
       g("bond_energy_released", bond_energy_released_);
@@ -160,6 +167,8 @@ class SolidSolver : public Mechanics {
     row("external_work", e.external_work);
     row("dissipation", e.dissipation);
     row("pore_pressure_work", e.pore_work);
+    if (face_pressure())
+      row("crack_force_work", e.crack_work);
     if (breaks()) {
       row("fracture_energy", e.fracture);
       row("bond_energy_released", e.bond_energy);
@@ -264,12 +273,14 @@ class SolidSolver : public Mechanics {
     // Work, dissipation, pore work and bond breakage of the step (this rank's points), then one
     // reduction.
     // w[0]: old forces on the increment (trapezoid, first half).
-    double w[6] = {0.5 * power(), 0, 0, 0, 0, 0};
+    // w[6]: the crack force's share of w[0], by the same trapezoid.
+    double w[7] = {0.5 * power(), 0, 0, 0, 0, 0, 0.5 * crack_power()};
     Kokkos::deep_copy(vs_old_,
                       Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
     st_.work = energy_criterion() ? BondWork::Accumulate : BondWork::Off;
     forces(t + dt);
     w[0] += 0.5 * power();  // new forces (second half)
+    w[6] += 0.5 * crack_power();
     w[1] = dt * damping_power();
     w[2] = pore_power() + eq17_power();
     keep_applied();
@@ -283,8 +294,9 @@ class SolidSolver : public Mechanics {
     }
     if (driver_)
       w[3] += double(driver_(t + dt).bonds);
-    MPI_Allreduce(MPI_IN_PLACE, w, 6, MPI_DOUBLE, MPI_SUM, comm_);
+    MPI_Allreduce(MPI_IN_PLACE, w, 7, MPI_DOUBLE, MPI_SUM, comm_);
     work_ += w[0];
+    crack_work_ += w[6];
     dissipation_ += w[1];
     pore_work_ += w[2];
     bond_energy_released_ += w[4];
@@ -413,6 +425,7 @@ class SolidSolver : public Mechanics {
     out.external_work = work_;
     out.dissipation = dissipation_;
     out.pore_work = pore_work_;
+    out.crack_work = crack_work_;
     out.fracture = fracture_energy_;
     out.plastic = plastic_dissipation_;
     out.bond_energy = bond_energy_released_;
@@ -488,21 +501,25 @@ class SolidSolver : public Mechanics {
     // fluid-driven crack (Example 1 at 66 x 66, K_w = 2.2 GPa, a_min = 0.1 mm: stable at 0.4 us,
     // unstable at 0.95 us, the skeleton's own limit being 1.9 us).
     const bool crack = face_pressure();
-    Scalars keep[4];
+    Scalars keep[5];
     if (crack) {
-      Scalars fields[4] = {p.pf, p.pf_saturation, p.pf_modulus, p.pf_aperture};
-      for (int k = 0; k < 4; ++k) {
+      Scalars fields[5] = {p.pf, p.pf_saturation, p.pf_modulus, p.pf_aperture, p.pf_area};
+      for (int k = 0; k < 5; ++k) {
         keep[k] = Scalars("keep", n);
         Kokkos::deep_copy(keep[k], fields[k]);
       }
+      // A point that joins has the face-area share of one row, V/dx (n_i = 1: the stiffest).
       const double joins = set_.fracture.water_modulus / set_.fracture.min_aperture;
+      const double inv_dx = 1.0 / disc_.grid.dx;
       auto pf = p.pf, sat = p.pf_saturation, mod = p.pf_modulus, ref = p.pf_aperture;
+      auto area = p.pf_area, vol = p.volume;
       auto frac = p.fracture;
       Kokkos::parallel_for(
           "mupm::Solid::crack_stiffness", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
             if (frac(i) && !(sat(i) > 0)) {
               sat(i) = 1.0;
               mod(i) = joins;
+              area(i) = vol(i) * inv_dx;
             }
             pf(i) = 0;
             ref(i) = 0;
@@ -520,8 +537,8 @@ class SolidSolver : public Mechanics {
         },
         comm_, iterations);
     if (crack) {
-      Scalars fields[4] = {p.pf, p.pf_saturation, p.pf_modulus, p.pf_aperture};
-      for (int k = 0; k < 4; ++k)
+      Scalars fields[5] = {p.pf, p.pf_saturation, p.pf_modulus, p.pf_aperture, p.pf_area};
+      for (int k = 0; k < 5; ++k)
         Kokkos::deep_copy(fields[k], keep[k]);
     }
     Kokkos::deep_copy(p.u, u0);
@@ -627,12 +644,14 @@ class SolidSolver : public Mechanics {
   }
   bool face_pressure() const { return set_.fracture.flow && set_.fracture.face_pressure; }
   // Adds the crack water's force density to `out` (owned points): p_f* at this displacement
-  // (undrained split, kernels/fracture_flow.hpp), onto the ghosts, then its pair forces.
+  // (undrained split, kernels/fracture_flow.hpp), the face loads g of that pressure onto the
+  // ghosts, then the forces of the broken bonds.
   void add_crack_force(const Vectors& out) {
     auto& p = disc_.points;
     undrained_fracture_pressure(disc_.bonds, p, pf_star_);
-    disc_.dist.refresh({as_vectors(pf_star_)});
-    crack_pressure_force(disc_.bonds, p, pf_star_, set_.fracture.crossing_measure, out);
+    crack_face_load(disc_.bonds, p, pf_star_, face_load_);
+    disc_.dist.refresh({face_load_});
+    crack_pressure_force(disc_.bonds, p, face_load_, out);
   }
   void add_to_body(const Vectors& f) {
     auto b = body_;
@@ -768,6 +787,26 @@ class SolidSolver : public Mechanics {
         w);
     return w;
   }
+  // Power of the crack water's face forces (crack_) on this step's increment, free components
+  // only, as in power() (this rank's points).
+  double crack_power() const {
+    if (!face_pressure())
+      return 0.0;
+    const auto& p = disc_.points;
+    auto f = crack_, du = du_;
+    auto vol = p.volume;
+    auto fixed = p.fixed;
+    double w = 0;
+    Kokkos::parallel_reduce(
+        "mupm::Solid::crack_work", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+          for (int k = 0; k < Dim; ++k)
+            if (!(fixed(i) & (1u << k)))
+              acc += f(i, k) * du(i, k) * vol(i);
+        },
+        w);
+    return w;
+  }
   // Damping power c (rho v.v + J omega.omega) V at the half step (this rank's points).
   double damping_power() const {
     if (set_.damping == 0)
@@ -803,12 +842,14 @@ class SolidSolver : public Mechanics {
   Scalars rho_, inertia_;
   Vectors body_, couple_, du_;
   Vectors crack_;           // the crack water's force density (Fracture Flow)
-  Scalars pf_star_;         // p_f* of the crack force (owned and ghosts)
+  Scalars pf_star_;         // p_f* of the crack force (owned points)
+  Vectors face_load_;       // g of the crack force (owned and ghosts; kernels/fracture_flow.hpp)
   double forces_time_ = 0;  // t of the last forces()
   Vectors f_old_, l_old_;   // forces of the old bond set at a breakage
   Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
-  double fracture_energy_ = 0;              // strain energy lost to bond breakage since t = 0 [J]
+  double crack_work_ = 0;       // work of the crack water's face forces since t = 0 [J] (Energy)
+  double fracture_energy_ = 0;  // strain energy lost to bond breakage since t = 0 [J]
   double plastic_dissipation_ = 0;          // plastic dissipation since t = 0 [J] (plastic law)
   double steps_ = 0;                        // steps since t = 0 (second-order work windows)
   double negative_fraction_ = 0;            // volume fraction with d2E < 0, last window
