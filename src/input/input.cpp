@@ -456,7 +456,15 @@ RCP<ParameterList> valid_parameters() {
           "Euler weighs the first fluid step with p = 0; the first solid steps of a ramped load) "
           "is of the same size as the terms.",
           at_least(0));
-    s.set("Number of Steps", 100, "Number of time steps (>= 0).", at_least(0));
+    s.set("Number of Steps", 100,
+          "Number of time steps (>= 0): the last step number (a restart continues up to it). "
+          "Not used when End Time > 0.",
+          at_least(0));
+    s.set("End Time", 0.0,
+          "Simulated time to run to [s]; > 0: the last step is the first whose time reaches it, "
+          "ceil(End Time / dt) with the dt in use (Automatic Time Step's estimate, or Time Step), "
+          "and Number of Steps is not used; 0: run Number of Steps.",
+          at_least(0.0));
     s.set("Restart From", std::string(""),
           "Checkpoint file (.h5) to continue from; empty: start at t = 0. The run may use a "
           "different number of ranks and threads than the one that wrote it.");

@@ -194,6 +194,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
   r.automatic_time_step = solver.get<bool>("Automatic Time Step");
   r.safety = solver.get<double>("Time Step Safety Factor");
   r.n_steps = solver.get<int>("Number of Steps");
+  r.end_time = solver.get<double>("End Time");
   r.energy_tolerance = solver.get<double>("Energy Tolerance");
   r.stop_on_energy_violation = solver.get<bool>("Stop On Energy Violation");
   r.energy_check_start = solver.get<int>("Energy Check Start");

@@ -349,21 +349,40 @@ void check_regions(const Model<Dim>& model, const Discretization<Dim>& disc, MPI
     check("Initial Conditions", ic.name, ic.region_mask);
 }
 
-// Reads Solver->Restart From: its errors are input errors naming the parameter, and a restart
-// must have steps left to take.
+// Reads Solver->Restart From: its errors are input errors naming the parameter.
 template <int Dim>
 void restart(const RunSettings& run, Discretization<Dim>& disc, long long& step, double& time,
              std::vector<double>& history, const NamedGlobals& globals) {
-  const std::string where = "Error, mupm->Solver->Restart From = '" + run.restart_from + "': ";
   try {
     read_checkpoint(run.restart_from, disc, step, time, history, globals);
   } catch (const CollectiveError& e) {
     throw InputError(restart_from_error(run.restart_from, e));
   }
-  if (step >= run.n_steps)
-    throw InputError(where + "the checkpoint is at step " + std::to_string(step) +
-                     ", and mupm->Solver->Number of Steps = " + std::to_string(run.n_steps) +
+}
+
+// The last step number: Number of Steps, or with End Time > 0 the first step whose time
+// step * dt reaches it. A quotient within 1e-9 of an integer is that integer, so that an End Time
+// that is a whole number of steps takes no extra step for the division's round-off. The same on
+// every rank (dt is), and after a restart (dt is the run's, choose_time_step). A restart must
+// have steps left to take.
+inline long long last_step_of(const RunSettings& run, double dt, long long step, bool restarted) {
+  long long last = run.n_steps;
+  std::string given = "mupm->Solver->Number of Steps = " + std::to_string(run.n_steps);
+  if (run.end_time > 0) {
+    const double n = run.end_time / dt;
+    last = std::llround(n);
+    if (std::abs(n - double(last)) > 1e-9 * n)
+      last = static_cast<long long>(std::ceil(n));
+    std::ostringstream s;
+    s << "mupm->Solver->End Time = " << run.end_time << " s (step " << last << " of dt = " << dt
+      << " s)";
+    given = s.str();
+  }
+  if (restarted && step >= last)
+    throw InputError("Error, mupm->Solver->Restart From = '" + run.restart_from +
+                     "': the checkpoint is at step " + std::to_string(step) + ", and " + given +
                      " is not beyond it: the restart would take no step.");
+  return last;
 }
 
 // The time step and the fluid's substeps from the modules' stable-step estimates (Automatic
@@ -727,16 +746,22 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   const bool restarted = !run.restart_from.empty();
   if (restarted) {
     restart(run, disc, step, time, history, ph.globals());
-    if (rank == 0) {
-      io::keep_rows_through(run.folder + "/time_series.csv", double(step));
+    if (rank == 0)
       out << "mupm: restarted from " << run.restart_from << " at step " << step << "\n";
-    }
   }
   ph.damage->update();
   disc.dist.refresh(pts.double_fields(kGhosted));
   ph.damage->update_aperture();
   ph.initialize(time, restarted);
   const double dt = choose_time_step(run, ph, restarted, rank, out);
+  const long long last_step = last_step_of(run, dt, step, restarted);
+  if (rank == 0 && run.end_time > 0)
+    out << "mupm: End Time = " << run.end_time << " s: " << last_step << " steps of " << dt
+        << " s (t = " << double(last_step) * dt << " s at the last)\n";
+  // The time series continues from the checkpoint's row (after the checks: a restart refused
+  // leaves it whole).
+  if (restarted && rank == 0)
+    io::keep_rows_through(run.folder + "/time_series.csv", double(step));
 
   FieldOutput<Dim> fields(run.folder, disc, run.fields, history);
   std::unique_ptr<io::CsvWriter> csv;
@@ -765,7 +790,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   }
 
   // ---------------------------------------------------------------- loop
-  const long long first_step = step, last_step = run.n_steps;
+  const long long first_step = step;
   StepChecks<Dim> checks(run, disc, mpi, rank, out);
   StableStepWatch<Dim> stable_steps(run, ph, n_bonds, dt, restarted, rank, out);
   const auto t_loop = Clock::now();

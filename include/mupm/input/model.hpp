@@ -54,6 +54,7 @@ struct RunSettings {
   bool automatic_time_step = false;
   double safety = 0.5;
   long long n_steps = 0;
+  double end_time = 0;  // > 0: run to this time instead of n_steps (last_step)
   double energy_tolerance = 1e-2;
   bool stop_on_energy_violation = false;
   long long energy_check_start = 20;
