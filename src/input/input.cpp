@@ -461,9 +461,10 @@ RCP<ParameterList> valid_parameters() {
           "Not used when End Time > 0.",
           at_least(0));
     s.set("End Time", 0.0,
-          "Simulated time to run to [s]; > 0: the last step is the first whose time reaches it, "
-          "ceil(End Time / dt) with the dt in use (Automatic Time Step's estimate, or Time Step), "
-          "and Number of Steps is not used; 0: run Number of Steps.",
+          "Simulated time to run to [s]; > 0: the run ends on the first step whose time reaches "
+          "it (within 1e-6 dt), ceil(End Time / dt) steps with the dt in use (Automatic Time "
+          "Step's estimate, or Time Step; a restart may take another), and Number of Steps is "
+          "not used; 0: run Number of Steps.",
           at_least(0.0));
     s.set("Restart From", std::string(""),
           "Checkpoint file (.h5) to continue from; empty: start at t = 0. The run may use a "

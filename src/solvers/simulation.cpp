@@ -360,29 +360,41 @@ void restart(const RunSettings& run, Discretization<Dim>& disc, long long& step,
   }
 }
 
-// The last step number: Number of Steps, or with End Time > 0 the first step whose time
-// step * dt reaches it. A quotient within 1e-9 of an integer is that integer, so that an End Time
-// that is a whole number of steps takes no extra step for the division's round-off. The same on
-// every rank (dt is), and after a restart (dt is the run's, choose_time_step). A restart must
-// have steps left to take.
-inline long long last_step_of(const RunSettings& run, double dt, long long step, bool restarted) {
-  long long last = run.n_steps;
-  std::string given = "mupm->Solver->Number of Steps = " + std::to_string(run.n_steps);
-  if (run.end_time > 0) {
-    const double n = run.end_time / dt;
-    last = std::llround(n);
-    if (std::abs(n - double(last)) > 1e-9 * n)
-      last = static_cast<long long>(std::ceil(n));
+// The run's end: Number of Steps, or with End Time > 0 the first step whose time reaches End Time
+// (within a millionth of a step, so that an End Time of a whole number of steps takes no extra
+// step for the round-off of the accumulated time). Decided on the accumulated time, which a
+// checkpoint keeps: a restart ends on the step the straight run ends on, also with another dt.
+inline bool run_ended(const RunSettings& run, long long step, double time, double dt) {
+  return run.end_time > 0 ? time >= run.end_time - 1e-6 * dt : step >= run.n_steps;
+}
+// The step run_ended will stop at, for the progress line: exact but for that round-off.
+inline long long expected_last_step(const RunSettings& run, long long step, double time,
+                                    double dt) {
+  if (!(run.end_time > 0))
+    return run.n_steps;
+  const double left = std::ceil((run.end_time - time) / dt - 1e-6);
+  return step + (left > 0 ? static_cast<long long>(left) : 0);
+}
+// Refuses a run that cannot end or a restart that would take no step (the same on every rank).
+inline void check_run_end(const RunSettings& run, long long step, double time, double dt,
+                          bool restarted) {
+  if (run.end_time > 0 && !(std::isfinite(dt) && dt > 0)) {
     std::ostringstream s;
-    s << "mupm->Solver->End Time = " << run.end_time << " s (step " << last << " of dt = " << dt
-      << " s)";
-    given = s.str();
+    s << "Error, mupm->Solver->End Time = " << run.end_time << " s: the time step is " << dt
+      << " s, which never reaches it. Set Solver->Time Step (with Automatic Time Step = false).";
+    throw InputError(s.str());
   }
-  if (restarted && step >= last)
-    throw InputError("Error, mupm->Solver->Restart From = '" + run.restart_from +
-                     "': the checkpoint is at step " + std::to_string(step) + ", and " + given +
-                     " is not beyond it: the restart would take no step.");
-  return last;
+  if (!restarted || !run_ended(run, step, time, dt))
+    return;
+  std::ostringstream given;
+  if (run.end_time > 0)
+    given << "mupm->Solver->End Time = " << run.end_time << " s is not beyond its time " << time
+          << " s";
+  else
+    given << "mupm->Solver->Number of Steps = " << run.n_steps << " is not beyond it";
+  throw InputError("Error, mupm->Solver->Restart From = '" + run.restart_from +
+                   "': the checkpoint is at step " + std::to_string(step) + ", and " + given.str() +
+                   ": the restart would take no step.");
 }
 
 // The time step and the fluid's substeps from the modules' stable-step estimates (Automatic
@@ -754,10 +766,12 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   ph.damage->update_aperture();
   ph.initialize(time, restarted);
   const double dt = choose_time_step(run, ph, restarted, rank, out);
-  const long long last_step = last_step_of(run, dt, step, restarted);
-  if (rank == 0 && run.end_time > 0)
-    out << "mupm: End Time = " << run.end_time << " s: " << last_step << " steps of " << dt
-        << " s (t = " << double(last_step) * dt << " s at the last)\n";
+  check_run_end(run, step, time, dt, restarted);
+  if (rank == 0 && run.end_time > 0) {
+    const long long last = expected_last_step(run, step, time, dt);
+    out << "mupm: End Time = " << run.end_time << " s: the last step is " << last << " ("
+        << last - step << " steps of " << dt << " s)\n";
+  }
   // The time series continues from the checkpoint's row (after the checks: a restart refused
   // leaves it whole).
   if (restarted && rank == 0)
@@ -795,25 +809,26 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   StableStepWatch<Dim> stable_steps(run, ph, n_bonds, dt, restarted, rank, out);
   const auto t_loop = Clock::now();
   auto t_last_progress = t_loop;
-  while (step < last_step) {
+  while (!run_ended(run, step, time, dt)) {
     {
       ScopedRegion region("mupm::Solver::step");
       ph.sequence.step(step, time, dt);
     }
     ++step;
     time += dt;
+    const bool last = run_ended(run, step, time, dt);
     checks(ph.modules(), step - first_step, step, time);
     stable_steps(step, time);
-    if (step % run.series_interval == 0 || step == last_step)
+    if (step % run.series_interval == 0 || last)
       write_series();
-    if ((run.field_interval > 0 && step % run.field_interval == 0) || step == last_step)
+    if ((run.field_interval > 0 && step % run.field_interval == 0) || last)
       fields.write(step, time);
-    if (run.checkpoint_interval > 0 && step % run.checkpoint_interval == 0 && step != last_step)
+    if (run.checkpoint_interval > 0 && step % run.checkpoint_interval == 0 && !last)
       checkpoint();
     // SIGTERM/SIGINT on any rank: checkpoint this step on all of them and stop.
     int stop = stop_requested() ? 1 : 0;
     MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, mpi);
-    if (stop && step != last_step) {
+    if (stop && !last) {
       if (step % run.series_interval != 0)
         write_series();  // the row of the step the restart continues from
       checkpoint();
@@ -821,10 +836,10 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
                         std::to_string(time) + " s); checkpoint written to " + checkpoint_path +
                         ": continue with Solver->Restart From = " + checkpoint_path + ".");
     }
-    if (rank == 0 &&
-        (seconds_since(t_last_progress) >= run.progress_interval || step == last_step)) {
+    if (rank == 0 && (seconds_since(t_last_progress) >= run.progress_interval || last)) {
       t_last_progress = Clock::now();
       const double el = seconds_since(t_loop);
+      const long long last_step = expected_last_step(run, step, time, dt);
       const double done = double(step - first_step), left = double(last_step - step);
       char line[256];
       std::snprintf(line, sizeof line,

@@ -197,27 +197,43 @@ run 2 1 done.xml >done.out 2>&1 || { cat done.out; fail "done.xml did not run"; 
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |
   sed -e 's|value="out"|value="again"|' -e 's|name="Number of Steps" type="int" value="2"|name="Number of Steps" type="int" value="1"|' >no_steps_left.xml
 expect no_steps_left 2 'the checkpoint is at step 2' 'mupm->Solver->Number of Steps = 1'
-# End Time (Time Step 1e-6 s): the last step is the first whose time reaches it, 1.5e-6 -> 2.
+# End Time (Time Step 1e-6 s): the run ends on the first step whose time reaches it; a restart
+# with no time left is refused and leaves the folder's time series whole.
+rm -rf kept && cp -r done kept
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/><Parameter name="End Time" type="double" value="1.5e-6"/>' |
-  sed 's|value="out"|value="again"|' >no_time_left.xml
-expect no_time_left 2 'the checkpoint is at step 2' 'mupm->Solver->End Time = 1.5e-06 s (step 2 of dt = 1e-06 s)'
-# A run to End Time stops at ceil(End Time / dt), an End Time of a whole number of steps (5e-6 s,
-# 5.000000000000001 steps in floating point) at that number, and a restart to it continues there.
+  sed 's|value="out"|value="kept"|' >no_time_left.xml
+expect no_time_left 2 'the checkpoint is at step 2' 'mupm->Solver->End Time = 1.5e-06 s is not beyond its time 2e-06 s'
+cmp -s done/time_series.csv kept/time_series.csv || fail "a refused restart changed the time series"
+# ceil(End Time / dt) steps: 3.5e-6 s -> 4; an End Time of a whole number of steps (5e-6 s, 5 steps
+# whose accumulated time is 5.000000000000001e-06 s) -> 5, no extra step.
 for end in 3.5e-6:4 5e-6:5; do
   base '' "<Parameter name=\"End Time\" type=\"double\" value=\"${end%:*}\"/>" |
     sed "s|value=\"out\"|value=\"end${end#*:}\"|" >end_time.xml
   run 2 1 end_time.xml >end_time.out 2>&1 || { cat end_time.out; fail "end_time.xml (${end%:*}) failed"; }
   last=$(tail -n 1 "end${end#*:}/time_series.csv" | cut -d, -f1)
   [[ $last == "${end#*:}" ]] || fail "End Time = ${end%:*} s with dt = 1e-6 s: last step $last, expected ${end#*:}"
-  grep -qF "s: ${end#*:} steps of 1e-06 s" end_time.out || { cat end_time.out; fail "no End Time line"; }
+  grep -qF "the last step is ${end#*:} (${end#*:} steps of 1e-06 s)" end_time.out || { cat end_time.out; fail "no End Time line"; }
 done
-rm -rf endr && cp -r done endr  # the 2-step run's folder, continued to 4.5e-6 s (5 steps)
+# A restart to End Time continues the folder's rows; with another Time Step (5e-7 s from the
+# checkpoint's t = 2e-6 s) it still ends at End Time: 5 more steps, last step 7 at t = 4.5e-6 s.
+rm -rf endr endh && cp -r done endr && cp -r done endh
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/><Parameter name="End Time" type="double" value="4.5e-6"/>' |
   sed 's|value="out"|value="endr"|' >end_restart.xml
 run 2 1 end_restart.xml >end_restart.out 2>&1 || { cat end_restart.out; fail "end_restart.xml failed"; }
 steps=$(tail -n +2 endr/time_series.csv | cut -d, -f1 | tr '\n' ' ')
 [[ $steps == "0 1 2 3 4 5 " ]] || fail "restart to End Time: time_series.csv steps are '$steps', expected 0 to 5"
-echo "ok: End Time (ceil(End Time / dt), whole numbers of steps, restart)"
+base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/><Parameter name="End Time" type="double" value="4.5e-6"/><Parameter name="Time Step" type="double" value="5e-7"/>' |
+  sed 's|value="out"|value="endh"|' >end_half.xml
+run 2 1 end_half.xml >end_half.out 2>&1 || { cat end_half.out; fail "end_half.xml failed"; }
+"$PYTHON" - <<'PY'
+import csv
+rows = list(csv.DictReader(open("endh/time_series.csv")))
+steps = [int(float(r["step"])) for r in rows]
+assert steps == list(range(8)), steps
+t = float(rows[-1]["time"])
+assert abs(t - 4.5e-6) < 1e-12, t
+PY
+echo "ok: End Time (ceil(End Time / dt), whole numbers of steps, restart, restart with another dt)"
 # --validate finds a checkpoint of another grid, as the run would.
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |
   sed 's|value="{20, 10}"|value="{20, 11}"|' >other_grid.xml

@@ -14,8 +14,10 @@
 namespace mupm {
 
 // The layout this mupm writes and reads (attribute mupm_checkpoint_version). 2: restart globals
-// by name.
-inline constexpr long long kCheckpointVersion = 2;
+// by name. 3: the crack water's face-area share (fracture_face_area), the run's time step
+// (stable_steps/time_step) and the crack water's energy globals: a version-2 checkpoint lacks
+// them, and is refused by its version rather than by a missing field.
+inline constexpr long long kCheckpointVersion = 3;
 
 // Named scalars, each pointing at its owner's value (written from it, read into it).
 using NamedGlobals = std::vector<std::pair<std::string, double*>>;

@@ -70,8 +70,12 @@
 // round-off for saturated crack water (C_f = phi_f / K_w constant over the step: psi's change is
 // then exactly C_f (p - p^n) p_m), as the water mass is; it checks the bookkeeping and the
 // linear solve, and for unsaturated crack water measures the step's linearization of C_f (taken
-// at p^n). The crack's volume at joining is not booked (as its water is not); neither is the
-// capillary energy psi dphi_f of the space an opening adds at fixed p (zero when saturated).
+// at p^n). The crack's volume at joining is not booked (as its water is not). The stored term is
+// sum V phi_f d(psi), not d(sum V phi_f psi): the energy psi dphi_f that the water filling an
+// opening's new space carries (p^2 / (2 K_w) per unit volume when saturated, p / (2 K_w) of the
+// skeleton work p dphi_f: 5e-4 at 2 MPa) is left out, as the content equation does. D, the
+// mean-pressure weighting of the flow, is not sign-definite step by step (it is the new
+// differences times the mean ones); summed over a run it is the dissipation to O(dt).
 #ifndef MUPM_SOLVERS_FRACTURE_FLOW_HPP
 #define MUPM_SOLVERS_FRACTURE_FLOW_HPP
 
