@@ -364,15 +364,16 @@ void restart(const RunSettings& run, Discretization<Dim>& disc, long long& step,
 // (within a millionth of a step, so that an End Time of a whole number of steps takes no extra
 // step for the round-off of the accumulated time). Decided on the accumulated time, which a
 // checkpoint keeps: a restart ends on the step the straight run ends on, also with another dt.
+constexpr double kEndTimeSlack = 1e-6;  // of a step (run_ended, expected_last_step)
 inline bool run_ended(const RunSettings& run, long long step, double time, double dt) {
-  return run.end_time > 0 ? time >= run.end_time - 1e-6 * dt : step >= run.n_steps;
+  return run.end_time > 0 ? time >= run.end_time - kEndTimeSlack * dt : step >= run.n_steps;
 }
 // The step run_ended will stop at, for the progress line: exact but for that round-off.
 inline long long expected_last_step(const RunSettings& run, long long step, double time,
                                     double dt) {
   if (!(run.end_time > 0))
     return run.n_steps;
-  const double left = std::ceil((run.end_time - time) / dt - 1e-6);
+  const double left = std::ceil((run.end_time - time) / dt - kEndTimeSlack);
   return step + (left > 0 ? static_cast<long long>(left) : 0);
 }
 // Refuses a run that cannot end or a restart that would take no step (the same on every rank).
