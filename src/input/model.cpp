@@ -91,14 +91,17 @@ const Options<int>& component_options() {
   return o;
 }
 
-// A mirrored Displacement condition (kernels/boundary_conditions.hpp, mirror_kinematic) holds
-// the normal component of the one face its region lies outside of and sets every component of
-// its points outside that face only, so its component must be that normal and no other
-// kinematic condition may reach those points (corners may be shared). Thrown on every rank (all
-// read the same input).
+// Mirrored kinematic conditions (kernels/boundary_conditions.hpp). A mirrored Displacement of
+// the normal of its face that is the only kinematic condition reaching its layer points makes
+// the layer the body's mirror image (mirror_kinematic: a symmetry plane). Any other mirrored
+// kinematic condition (a tangential Displacement, a Micro-Rotation, or several on one layer,
+// such as a clamp) slaves the layer (slave_layer): its points carry no strain energy, so every
+// kinematic condition that reaches them must be mirrored too and share their region. Sets
+// BoundaryCondition::slaved. Thrown on every rank (all read the same input).
 template <int Dim>
-void check_mirrored_kinematic(const GridSpec<Dim>& g, const std::vector<BoundaryCondition>& bcs,
-                              const std::string& root, Physics physics) {
+void check_mirrored_kinematic(const GridSpec<Dim>& g, std::vector<BoundaryCondition>& bcs,
+                              const std::string& root, Physics physics, ConstitutiveModel model,
+                              BondBreaking breaking) {
   const char* axes = "xyz";
   // Whether region mask b reaches the points of region mask a (outside face `axis`) that lie
   // outside that face only: a's box clipped to the body along the other axes. Points sit at
@@ -124,7 +127,7 @@ void check_mirrored_kinematic(const GridSpec<Dim>& g, const std::vector<Boundary
       }
     return false;
   };
-  for (const auto& bc : bcs) {
+  for (auto& bc : bcs) {
     if (!(bc.kinematic() && bc.mirrored))
       continue;
     const std::string path = root + "->Boundary Conditions->" + bc.name + "->";
@@ -133,32 +136,51 @@ void check_mirrored_kinematic(const GridSpec<Dim>& g, const std::vector<Boundary
     // pressure is its own unknown, not the mirror image of the body's, so the coupled operator
     // is not symmetric; refused until the layer's water is mirrored too.
     if (physics != Physics::MicropolarSolid)
-      throw InputError("Error, " + path +
-                       "Boundary Layer Values = Mirrored: mirrored "
-                       "Displacement layers need " +
-                       root +
-                       "->Solver->Physics = Micropolar "
-                       "Solid (with pore water they were measured unstable; write Constant).");
+      throw InputError(
+          "Error, " + path + "Boundary Layer Values = Mirrored: mirrored " +
+          (bc.kind == BoundaryCondition::Displacement ? "Displacement" : "Micro-Rotation") +
+          " layers need " + root +
+          "->Solver->Physics = Micropolar Solid (with pore water they were measured "
+          "unstable; write Constant).");
     const int axis = face_axis(g, bc.region_mask);
     if (axis < 0)
       throw InputError("Error, " + path +
-                       "Boundary Layer Values = Mirrored: a mirrored "
-                       "Displacement needs a region that lies outside exactly one face of the "
-                       "body (a boundary layer such as 'Layer -x').");
-    if (axis != bc.component)
-      throw InputError("Error, " + path + "Component = " + std::string(1, axes[bc.component]) +
-                       " with Boundary Layer Values = Mirrored: a mirrored Displacement holds the "
-                       "normal of its face (" +
-                       std::string(1, axes[axis]) +
-                       " here; the layer is the body's mirror image about u_n = g, which leaves "
-                       "the other components no value of their own).");
+                       "Boundary Layer Values = Mirrored: a mirrored condition needs a region "
+                       "that lies outside exactly one face of the body (a boundary layer such as "
+                       "'Layer -x').");
+    bool alone = true;
     for (const auto& other : bcs)
       if (&other != &bc && other.kinematic() && overlap(bc.region_mask, axis, other.region_mask))
+        alone = false;
+    bc.slaved = !(alone && bc.kind == BoundaryCondition::Displacement && bc.component == axis);
+    if (!bc.slaved)
+      continue;
+    // Slaved layers are built and measured for the elastic solid whose bonds stay intact:
+    // breakage accumulates bond energies from the increments, which the slaving rewrites
+    // (slaved_increment), and the plastic law's state on energy-free points is not defined.
+    if (model != ConstitutiveModel::MicropolarElastic || breaking != BondBreaking::None)
+      throw InputError("Error, " + path + "Boundary Layer Values = Mirrored on a " +
+                       (bc.kind == BoundaryCondition::Displacement
+                            ? std::string("Displacement of component ") + axes[bc.component]
+                            : std::string("Micro-Rotation")) +
+                       " slaves its layer (energy-free points), which is implemented for "
+                       "Materials->Model = Micropolar Elastic with Fracture->Bond Breakage = None "
+                       "only; write Constant, or mirror the normal Displacement alone (a "
+                       "symmetry plane).");
+    for (const auto& other : bcs) {
+      if (&other == &bc || !other.kinematic() || !overlap(bc.region_mask, axis, other.region_mask))
+        continue;
+      if (!other.mirrored || other.region_mask != bc.region_mask)
         throw InputError("Error, " + path +
-                         "Boundary Layer Values = Mirrored sets every "
-                         "component of its layer points (those outside its face only), but " +
+                         "Boundary Layer Values = Mirrored slaves the points of its layer (they "
+                         "carry no strain energy and follow their mirrors), but " +
                          root + "->Boundary Conditions->" + other.name +
-                         " also prescribes some of them.");
+                         (other.mirrored ? " reaches some of them with another Region; give "
+                                           "both the same Region."
+                                         : " also prescribes some of them with constant "
+                                           "values; write Boundary Layer Values = Mirrored "
+                                           "there too, or Constant here."));
+    }
   }
 }
 
@@ -293,7 +315,8 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.boundary_conditions = boundary_conditions_from_input(input);
   for (const auto& bc : m.boundary_conditions)
     m.grid.mirrored_layers = m.grid.mirrored_layers || bc.mirrored;
-  check_mirrored_kinematic(m.grid, m.boundary_conditions, input.name(), r.physics);
+  check_mirrored_kinematic(m.grid, m.boundary_conditions, input.name(), r.physics,
+                           m.constitutive_model, m.fracture.criterion);
   check_fluid_flux(m.grid, m.boundary_conditions, input.name());
   m.initial_conditions = initial_conditions_from_input(input);
   return m;

@@ -59,4 +59,35 @@ void Distribution::refresh(const std::vector<Vectors>& fields) {
   ++refresh_count_;
 }
 
+void Distribution::add_to_owners(const Vectors& buf) {
+  ScopedRegion region("mupm::Comm::add_to_owners");
+  const std::size_t width = buf.extent(1);
+  if (width == 0)
+    return;
+  if (sum_owned_.is_null() || sum_owned_->getNumVectors() != width) {
+    sum_owned_ = Teuchos::rcp(new MultiVector(owned_map_, width, false));
+    sum_overlap_ = Teuchos::rcp(new MultiVector(overlap_map_, width, false));
+  }
+  const std::size_t n_own = n_owned_, n_all = n_owned_ + n_ghost_;
+  {
+    auto b = sum_overlap_->getLocalViewDevice(Tpetra::Access::OverwriteAll);
+    Kokkos::parallel_for(
+        "mupm::Comm::pack_sum", range(0, n_all), KOKKOS_LAMBDA(const std::size_t i) {
+          for (std::size_t c = 0; c < width; ++c)
+            b(i, c) = buf(i, c);
+        });
+  }
+  sum_owned_->putScalar(0.0);
+  sum_owned_->doExport(*sum_overlap_, *importer_, Tpetra::ADD);
+  {
+    auto b = sum_owned_->getLocalViewDevice(Tpetra::Access::ReadOnly);
+    Kokkos::parallel_for(
+        "mupm::Comm::unpack_sum", range(0, n_own), KOKKOS_LAMBDA(const std::size_t i) {
+          for (std::size_t c = 0; c < width; ++c)
+            buf(i, c) = b(i, c);
+        });
+  }
+  Kokkos::fence();
+}
+
 }  // namespace mupm

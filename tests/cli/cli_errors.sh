@@ -163,7 +163,7 @@ cat >>empty_region.xml <<'XML'
 </ParameterList>
 XML
 expect empty_region 2 "mupm->Boundary Conditions->pull->Region = 'outside' holds no point"
-# Mirrored boundary-layer values are for Pore Pressure and Displacement conditions only.
+# Mirrored boundary-layer values are for Pore Pressure, Displacement and Micro-Rotation only.
 base '<Parameter name="Boundary Layers" type="Array(string)" value="{-x}"/>' '' | sed '$d' >mirrored_kinematic.xml
 cat >>mirrored_kinematic.xml <<'XML'
   <ParameterList name="Boundary Conditions"><ParameterList name="hold">
@@ -173,12 +173,19 @@ cat >>mirrored_kinematic.xml <<'XML'
   </ParameterList></ParameterList>
 </ParameterList>
 XML
-expect mirrored_kinematic 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'only Pore Pressure and Displacement'
-# A mirrored Displacement holds its face's normal component only.
+expect mirrored_kinematic 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'only Pore Pressure, Displacement and Micro-Rotation'
+# A mirrored tangential Displacement slaves its layer (energy-free points), so no condition may
+# hold constant values on the same points.
 sed -e 's|value="Velocity"|value="Displacement"|' \
   -e 's|<Parameter name="Region" type="string" value="Layer -x"/>|&<Parameter name="Component" type="string" value="y"/>|' \
+  -e 's|</ParameterList></ParameterList>|</ParameterList><ParameterList name="hold2"><Parameter name="Type" type="string" value="Displacement"/><Parameter name="Region" type="string" value="Layer -x"/></ParameterList></ParameterList>|' \
   mirrored_kinematic.xml >mirrored_tangential.xml
-expect mirrored_tangential 2 'mupm->Boundary Conditions->hold->Component = y with Boundary Layer Values = Mirrored' 'holds the normal of its face (x here'
+expect mirrored_tangential 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored slaves the points of its layer' 'mupm->Boundary Conditions->hold2 also prescribes some of them with constant values'
+# ... and slaved layers are for the elastic solid without bond breakage.
+sed -e 's|<ParameterList name="hold2">.*</ParameterList></ParameterList>|</ParameterList>|' \
+  -e 's|<ParameterList name="Materials">|<ParameterList name="Fracture"><Parameter name="Bond Breakage" type="string" value="Energy"/><Parameter name="Critical Energy Release Rate" type="double" value="100"/></ParameterList>&|' \
+  mirrored_tangential.xml >mirrored_breakage.xml
+expect mirrored_breakage 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored on a Displacement of component y' 'Fracture->Bond Breakage = None'
 # ... and mirrored Displacement for a solid without pore water only (measured unstable with it).
 base '<Parameter name="Boundary Layers" type="Array(string)" value="{-x}"/>' \
   '<Parameter name="Physics" type="string" value="Hydro-Mechanical"/>' |

@@ -29,6 +29,10 @@ enum PointFlag : std::uint32_t {
 
 // Bit of Points::fixed marking a prescribed pore pressure (bits 0..Dim+RotDim-1: u and theta).
 inline constexpr std::uint32_t kFixedPressure = 1u << 31;
+// Bit of Points::fixed marking a point that carries no strain energy: a boundary-layer point
+// slaved to its mirror (Boundary Layer Values = Mirrored on a clamp). Pass 1 gives it zero
+// states (include/mupm/kernels/solid.hpp), so the body's energy is its real points' alone.
+inline constexpr std::uint32_t kFixedNoEnergy = 1u << 30;
 
 inline constexpr std::uint32_t layer_face_flag(int axis, int side) {
   return kFlagLayerFace0 << (2 * axis + side);

@@ -170,8 +170,28 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;  // G C1 |xi|^3
   const double c2 = prm.stabilization * prm.stab_modulus;         // G C2 |xi|
   const double inv_vh = 1.0 / prm.horizon_volume;
+  auto fixed = pts.fixed;
   Kokkos::parallel_for(
       "mupm::Solid::pass1", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        // A slaved boundary-layer point (kernels/boundary_conditions.hpp, slave_layer) carries no
+        // strain energy: zero states, so its own T_ij = M_ij = 0 and its energy 0; the body's
+        // states still reach it (pass 2), which is the force the slaving folds back.
+        if (fixed(i) & kFixedNoEnergy) {
+          for (int k = 0; k < Dim * Dim; ++k) {
+            eps_v(i, k) = P1(i, k) = sigma_v(i, k) = 0;
+            if (effective)
+              P1w(i, k) = 0;
+            if (eq17)
+              P1f(i, k) = 0;
+          }
+          for (int k = 0; k < R * Dim; ++k)
+            kap_v(i, k) = P2(i, k) = m_v(i, k) = 0;
+          w0_v(i) = 0;  // no stabilization of its own (pass 2 skips w0 = 0)
+          pstar(i) = p(i);
+          degen(i) = 0;
+          energy(i) = 0;
+          return;
+        }
         double A[Dim * Dim] = {}, B[R * Dim] = {};
         for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
           if (!intact(b))

@@ -37,6 +37,13 @@ class Distribution {
   // of the other ranks that need them. Fields of one call travel together in one MultiVector.
   void refresh(const std::vector<Vectors>& fields);
   std::size_t refresh_count() const { return refresh_count_; }
+  // The reverse of refresh: every rank's ghost rows of `buf` ([n_owned + n_ghost][ncomp]) are
+  // added to the owned rows of their owners (Tpetra doExport with ADD through the same Import,
+  // in reverse mode), which then hold their own rows plus the other ranks' contributions. The
+  // ghost rows are left as they were. The sum over ranks is in Tpetra's order: bit-identical on
+  // any rank count only when each entry has at most one nonzero contribution (the fold of the
+  // slaved boundary layers, kernels/boundary_conditions.hpp, is built so).
+  void add_to_owners(const Vectors& buf);
 
  private:
   Teuchos::RCP<const Comm> comm_;
@@ -45,6 +52,7 @@ class Distribution {
   std::size_t n_owned_ = 0, n_ghost_ = 0, refresh_count_ = 0;
   // Buffers kept between calls of the same width to avoid re-allocation every step.
   Teuchos::RCP<MultiVector> owned_buf_, overlap_buf_;
+  Teuchos::RCP<MultiVector> sum_owned_, sum_overlap_;  // add_to_owners
 };
 
 }  // namespace mupm

@@ -174,6 +174,18 @@ int face_axis(const GridSpec<Dim>& g, std::uint32_t mask) {
   }
   return count == 1 ? axis : -1;
 }
+// 2 axis + side of the one face region `mask` lies outside of (side 0: below the body's low
+// face), or -1 (face_axis).
+template <int Dim>
+int face_index(const GridSpec<Dim>& g, std::uint32_t mask) {
+  const int axis = face_axis(g, mask);
+  if (axis < 0)
+    return -1;
+  int r = 0;
+  while (!(mask & (1u << r)))
+    ++r;
+  return 2 * axis + (g.regions[r].hi[axis] < g.origin[axis] ? 0 : 1);
+}
 // The column of Discretization::mirror a condition on region `mask` reflects with.
 template <int Dim>
 int face_column(const GridSpec<Dim>& g, std::uint32_t mask) {

@@ -92,12 +92,20 @@ class SolidSolver : public Mechanics {
       : disc_(disc), prm_(prm), law_(law), bcs_(std::move(bcs)), set_(settings), comm_(comm) {
     if constexpr (std::is_same_v<Law, MicropolarElastic>)
       law_ = prm.law;
+    int blocks = 0;  // faces with slaved layers, in the order of the conditions (every rank's)
+    for (int f = 0; f < 6; ++f)
+      slots_[f] = -1;
     for (auto& bc : bcs_)
       if (bc.kinematic() && bc.mirrored) {
         bc.mirror_column = face_column(disc.grid, bc.region_mask);
-        mirrored_ = true;
+        (bc.slaved ? slaved_ : mirrored_) = true;
+        const int face = face_index(disc.grid, bc.region_mask);
+        if (bc.slaved && slots_[face] < 0)
+          slots_[face] = blocks++;
       }
     auto& p = disc_.points;
+    if (slaved_)
+      fold_ = Vectors("mupm::layer_fold", p.size(), std::size_t(blocks * (Dim + R)));
     st_.allocate(p.size(), p.n_owned);
     rho_ = Scalars("mupm::density", p.n_owned);
     inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
@@ -226,6 +234,8 @@ class SolidSolver : public Mechanics {
     mark_fixed(bcs_, p);
     if (mirrored_)
       mark_mirrored_fixed(bcs_, p, disc_.mirror);
+    if (slaved_)
+      mark_slaved(bcs_, p, disc_.mirror);
     update_density();
     // Pore water pressure, for the whole run: a fluid (undrained modulus set from the start), or
     // a held initial pressure (without a fluid p never changes). The effective force state's
@@ -270,21 +280,27 @@ class SolidSolver : public Mechanics {
     apply_kinematic(bcs_, p, t, dt);
     mirror_layers(t + dt);
     increments();
+    if (slaved_)
+      for (const auto& bc : bcs_)
+        if (bc.kinematic() && bc.slaved)
+          slaved_increment(bc, p, du_, t, dt);
     // Work, dissipation, pore work and bond breakage of the step (this rank's points), then one
     // reduction.
-    // w[0]: old forces on the increment (trapezoid, first half).
-    // w[6]: the crack force's share of w[0], by the same trapezoid.
-    double w[7] = {}, half[2];
-    power(half);
-    w[0] = 0.5 * half[0];
-    w[6] = 0.5 * half[1];
+    // w[0]: the external work, w[6]: the crack force's share of it, both by the trapezoid rule
+    // on the forces at the step's start and end.
+    double w[7] = {};
+    auto trapezoid_half = [&] {
+      double half[2];
+      power(half);
+      w[0] += 0.5 * half[0];
+      w[6] += 0.5 * half[1];
+    };
+    trapezoid_half();
     Kokkos::deep_copy(vs_old_,
                       Kokkos::subview(p.vol_strain, std::make_pair(std::size_t(0), p.n_owned)));
     st_.work = energy_criterion() ? BondWork::Accumulate : BondWork::Off;
     forces(t + dt);
-    power(half);  // new forces (second half)
-    w[0] += 0.5 * half[0];
-    w[6] += 0.5 * half[1];
+    trapezoid_half();
     w[1] = dt * damping_power();
     w[2] = pore_power() + eq17_power();
     keep_applied();
@@ -436,7 +452,8 @@ class SolidSolver : public Mechanics {
     return out;
   }
 
-  // Force (moment) the boundary applies on each kinematic condition's points: -sum f V.
+  // Force (moment) the boundary applies on each kinematic condition's points: -sum f V; on a
+  // slaved layer's points dPsi/dg = -2 sum f V (kernels/boundary_conditions.hpp, slave_layer).
   std::vector<std::string> reaction_names() const {
     std::vector<std::string> n;
     for (const auto& bc : bcs_)
@@ -456,12 +473,13 @@ class SolidSolver : public Mechanics {
       const std::uint32_t mask = bc.region_mask;
       auto regions = p.regions;
       auto vol = p.volume;
+      auto fixed = p.fixed;
       double s = 0;
       Kokkos::parallel_reduce(
           "mupm::Solid::reaction", range(0, p.n_owned),
           KOKKOS_LAMBDA(const std::size_t i, double& acc) {
             if (mask == 0 || (regions(i) & mask))
-              acc -= f(i, c) * vol(i);
+              acc -= ((fixed(i) & kFixedNoEnergy) ? 2.0 : 1.0) * f(i, c) * vol(i);
           },
           s);
       MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
@@ -535,7 +553,14 @@ class SolidSolver : public Mechanics {
         op, Dim + R, p.n_owned, p.gid, p.volume,
         [&] {
           disc_.dist.refresh({p.u, p.theta});
+          if (slaved_) {  // the slaving's linear part (g = 0), then its fold: P^T K P
+            for (const auto& bc : bcs_)
+              if (bc.kinematic() && bc.slaved)
+                slave_layer(bc, p, disc_.mirror, 0.0, true);
+            disc_.dist.refresh({p.u, p.theta});
+          }
           solid_forces(disc_, prm_, prm_.law, st_);  // elastic: the stiffest tangent, no state
+          fold_layers();
           if (crack)
             add_crack_force(st_.force);
         },
@@ -588,14 +613,27 @@ class SolidSolver : public Mechanics {
   // (kernels/boundary_conditions.hpp, mirror_kinematic), after the step has moved the body: the
   // mirrors' new values reach the ghosts first (one extra refresh per step, only with such
   // conditions).
+  // The slaved layers' likewise (slave_layer).
   void mirror_layers(double t) {
-    if (!mirrored_)
+    if (!mirrored_ && !slaved_)
       return;
     auto& p = disc_.points;
     disc_.dist.refresh({p.u, p.theta, p.v});
     for (const auto& bc : bcs_)
       if (bc.kinematic() && bc.mirrored)
-        mirror_kinematic(bc, p, disc_.mirror, t);
+        bc.slaved ? slave_layer(bc, p, disc_.mirror, t) : mirror_kinematic(bc, p, disc_.mirror, t);
+  }
+  // The slaved layer points' forces and moments onto their mirrors (pack_layer_forces), across
+  // ranks. The layer points keep theirs: the reactions and the external work are made of them.
+  void fold_layers() {
+    if (!slaved_)
+      return;
+    ScopedRegion region("mupm::Solid::fold_layers");
+    auto& p = disc_.points;
+    Kokkos::deep_copy(fold_, 0.0);
+    pack_layer_forces(p, disc_.mirror, slots_, st_.force, st_.moment, fold_);
+    disc_.dist.add_to_owners(fold_);
+    add_folded(p, fold_, st_.force, st_.moment);
   }
 
   void forces(double t) {
@@ -605,6 +643,7 @@ class SolidSolver : public Mechanics {
     else
       disc_.dist.refresh({p.u, p.theta});
     solid_forces(disc_, prm_, law_, st_);
+    fold_layers();
     body_force_density(bcs_, p, disc_.grid.dx, t, body_, couple_);
     if (face_pressure()) {  // the crack's water on its faces (kernels/fracture_flow.hpp)
       Kokkos::deep_copy(crack_, 0.0);
@@ -772,7 +811,6 @@ class SolidSolver : public Mechanics {
   // prescribed components the boundary holds the point against the body's force density f (it
   // applies -f V); on free components gravity and the body/traction forces act. out[1]: the
   // crack water's face forces' share of it (crack_, part of the body force; free components).
-  // One loop for both: the crack's share cost a second pass over the points (0.7 % of a step).
   void power(double out[2]) const {
     const auto& p = disc_.points;
     auto f = st_.force, l = st_.moment, b = body_, bc = couple_, du = du_;
@@ -847,6 +885,9 @@ class SolidSolver : public Mechanics {
   double bond_energy_released_ = 0;         // W V_i V_j of the bonds broken since t = 0 [J]
   double broken_pairs_ = 0;                 // bond pairs broken since t = 0 (a restart global)
   bool mirrored_ = false;                   // mirrored Displacement conditions (mirror_layers)
+  bool slaved_ = false;                     // slaved layers (slave_layer, fold_layers)
+  Vectors fold_;                            // fold_layers' buffer [owned + ghosts][columns]
+  FaceSlots slots_;                         // fold_'s block of each face (-1: none)
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
   bool keep_pore_part_ = false;             // P1w for the J-integral (keep_pore_part)
   std::function<Breakage(double)> driver_;  // the J criterion (set_crack_driver), at time t
