@@ -3,7 +3,9 @@
 // the whole force evaluation (solid_forces: pass 1, ghost refresh, pass 2), in 2D (400 x 400)
 // and 3D (50^3) at delta = 3.015 dx and 4.015 dx, pass 1 also with the Drucker-Prager law; and what
 // bond breakage adds to a step: the force evaluation with the bond-energy accumulation, the
-// breakage scan, the damage update. Run: OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads
+// breakage scan, the damage update; and the fold of slaved boundary layers (Boundary Layer Values
+// = Mirrored on a clamp) on the same grids with a clamp's layer on both y faces. Run:
+// OMP_NUM_THREADS=T OMP_PROC_BIND=spread OMP_PLACES=threads
 // ./perf/bench_solid
 #include <cmath>
 
@@ -158,6 +160,59 @@ void BM_SolidForcesWithBreakage(benchmark::State& state) {
   set_counters(state, b);
 }
 
+// The same body with one-horizon boundary layers on both y faces, every point of them slaved (a
+// clamp: all components held, energy-free), for the fold of their forces onto their mirrors
+// (kernels/boundary_conditions.hpp; SolidSolver::fold_layers): zero the buffer, pack, the Tpetra
+// export that adds ghost rows into their owners (on one rank its fixed cost and the copies of all
+// rows in and out), add. What a step with slaved layers adds to BM_SolidForces.
+template <int Dim>
+struct LayeredBody : Body<Dim> {
+  static GridSpec<Dim> layered(GridSpec<Dim> g) {
+    g.layers[1] = {g.horizon_cells(), g.horizon_cells()};
+    g.mirrored_layers = true;
+    return g;
+  }
+  explicit LayeredBody(const GridSpec<Dim>& g) : Body<Dim>(layered(g)) {
+    auto& p = this->disc.points;
+    auto fixed = p.fixed;
+    auto mirror = this->disc.mirror;
+    constexpr std::uint32_t all = (1u << (Dim + kRotDim<Dim>)) - 1;
+    Kokkos::parallel_for(
+        "bench::mark_slaved", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          if (mirror(i, Dim) >= 0)
+            fixed(i) |= all | kFixedNoEnergy;
+        });
+    Kokkos::fence();
+  }
+};
+
+template <int Dim>
+void BM_SolidFold(benchmark::State& state) {
+  auto& b = bench::body<LayeredBody<Dim>>(state);
+  auto& p = b.disc.points;
+  constexpr int N = Dim + kRotDim<Dim>;
+  const FaceSlots slots{-1, -1, 0, 1, -1, -1};  // the two y faces
+  Vectors fold("fold", p.size(), 2 * N);
+  solid_forces(b.disc, b.prm, b.st);
+  double slaved = 0;
+  auto fixed = p.fixed;
+  Kokkos::parallel_reduce(
+      "bench::slaved_points", range(0, p.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+        acc += (fixed(i) & kFixedNoEnergy) ? 1.0 : 0.0;
+      },
+      slaved);
+  for (auto _ : state) {
+    Kokkos::deep_copy(fold, 0.0);
+    pack_layer_forces(p, b.disc.mirror, slots, b.st.force, b.st.moment, fold);
+    b.disc.dist.add_to_owners(fold);
+    add_folded(p, fold, b.st.force, b.st.moment);
+    Kokkos::fence();
+  }
+  state.counters["slaved_points"] = slaved;
+  set_counters(state, b);
+}
+
 // Grouped by configuration so that the output reads pass1, pass2, forces for each grid.
 // UseRealTime: Google Benchmark's default clock (and so every rate counter) is the CPU time of
 // the calling thread alone, not the wall time of the parallel region: on a loaded machine the
@@ -181,6 +236,10 @@ void BM_SolidForcesWithBreakage(benchmark::State& state) {
       ->Unit(benchmark::kMillisecond)                 \
       ->UseRealTime();                                \
   BENCHMARK_TEMPLATE(BM_SolidForcesWithBreakage, Dim) \
+      ->Args({n, factor})                             \
+      ->Unit(benchmark::kMillisecond)                 \
+      ->UseRealTime();                                \
+  BENCHMARK_TEMPLATE(BM_SolidFold, Dim)               \
       ->Args({n, factor})                             \
       ->Unit(benchmark::kMillisecond)                 \
       ->UseRealTime()
