@@ -203,11 +203,7 @@ void BM_SolidFold(benchmark::State& state) {
       },
       slaved);
   for (auto _ : state) {
-    Kokkos::deep_copy(fold, 0.0);
-    pack_layer_forces(p, b.disc.mirror, slots, b.st.force, b.st.moment, fold);
-    b.disc.dist.add_to_owners(fold);
-    add_folded(p, fold, b.st.force, b.st.moment);
-    Kokkos::fence();
+    fold_layer_forces(b.disc, slots, b.st.force, b.st.moment, fold);
   }
   state.counters["slaved_points"] = slaved;
   set_counters(state, b);

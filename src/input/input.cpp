@@ -143,19 +143,21 @@ void bc_template(ParameterList& c) {
         "Values on boundary-layer points. Pore Pressure: Constant (the prescribed value g, the "
         "paper's method) or Mirrored (2 g - p of the body point mirrored about the face, so that "
         "p passes through g at the face); Default: Discretization->Boundary Layer Values. "
-        "Displacement and Micro-Rotation (Physics = Micropolar Solid): Mirrored (this parameter "
-        "only; the region must lie outside one face). A mirrored Displacement of the face's "
+        "Displacement, Velocity and Micro-Rotation (Physics = Micropolar Solid): Mirrored (this "
+        "parameter only; the region must lie outside one face). A mirrored Displacement of the "
+        "face's "
         "normal that is the only kinematic condition of its layer makes the layer the mirror "
         "image of the body about a symmetry plane at u_n = g (u_n = 2 g - u_n, u_t and theta "
         "reflected: a roller with zero tangential micro-rotation). Any other mirrored "
-        "Displacement or Micro-Rotation (e.g. a clamp: x, y and the rotation, each Mirrored, on "
+        "kinematic condition (e.g. a clamp: x, y and the rotation, each Mirrored, on "
         "one layer) slaves its layer: the layer's points carry no strain energy and each "
-        "prescribed component takes 2 g - v(m) of the mirror point m, so the field passes "
-        "through g at the face; components without a condition stay free; every kinematic "
+        "prescribed component takes 2 g - v(m) of the mirror point m (for Velocity, g is the "
+        "displacement it has prescribed), so the field passes through g at the face; components "
+        "without a condition stay free; every kinematic "
         "condition on the layer must then be Mirrored with the same Region (Micropolar Elastic, "
         "no bond breakage). Default and Constant hold g. Points of the region that are not "
-        "outside its face only (corners, body points) hold g either way. Velocity is Constant "
-        "only (README, 'Boundary layers').",
+        "outside its face only (corners, body points) hold g either way (README, 'Boundary "
+        "layers').",
         one_of({"Default", "Constant", "Mirrored"}));
 }
 
@@ -216,7 +218,7 @@ RCP<ParameterList> valid_parameters() {
           "Mirrored: a layer point at distance d outside the face takes 2 g - p(m), p(m) the "
           "pressure of the point m at distance d inside, every fluid substep (the face: the one "
           "the condition's region lies outside of). Kinematic conditions stay Constant unless "
-          "their own Boundary Layer Values says Mirrored (Displacement, Micro-Rotation). See "
+          "their own Boundary Layer Values says Mirrored. See "
           "README, 'Boundary layers'.",
           one_of({"Constant", "Mirrored"}));
     ParameterList& r = d.sublist("Regions", false,
@@ -814,14 +816,13 @@ void check_dimension_arrays(ParameterList& input) {
                        "body's pressure continued with the flux's gradient); leave it Default.");
     // An odd reflection of the held components of layers that keep their energy was built and
     // measured unstable (not an invariant subspace of the vector operator: Terzaghi's column grew
-    // without bound at H = 40 dx). Displacement and Micro-Rotation conditions mirror by the
-    // reflection R (a symmetry plane) or by slaving energy-free layers (input/model.cpp,
-    // kernels/boundary_conditions.hpp); Velocity is refused rather than run.
+    // without bound at H = 40 dx). Kinematic conditions mirror by the reflection R (a symmetry
+    // plane) or by slaving energy-free layers (input/model.cpp, kernels/boundary_conditions.hpp).
     if (c.get<std::string>("Boundary Layer Values") == "Mirrored" &&
         type != BoundaryCondition::PorePressure && type != BoundaryCondition::Displacement &&
-        type != BoundaryCondition::MicroRotation)
+        type != BoundaryCondition::Velocity && type != BoundaryCondition::MicroRotation)
       throw InputError("Error, " + path_of(c, "Boundary Layer Values") +
-                       " = Mirrored: only Pore Pressure, Displacement and Micro-Rotation "
+                       " = Mirrored: only Pore Pressure, Displacement, Velocity and Micro-Rotation "
                        "conditions mirror their boundary-layer values; " +
                        c.get<std::string>("Type") +
                        " conditions hold the prescribed value (write Constant or Default).");
@@ -1343,9 +1344,7 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterLis
     // condition mirrors when it says so itself (input/model.cpp, check_mirrored_kinematic).
     bc.mirrored = bc.kind == BoundaryCondition::FluidFlux ||
                   (bc.kind == BoundaryCondition::PorePressure && values == "Mirrored") ||
-                  ((bc.kind == BoundaryCondition::Displacement ||
-                    bc.kind == BoundaryCondition::MicroRotation) &&
-                   c.get<std::string>("Boundary Layer Values") == "Mirrored");
+                  (bc.kinematic() && c.get<std::string>("Boundary Layer Values") == "Mirrored");
     out.push_back(bc);
   }
   return out;

@@ -94,14 +94,19 @@ const Options<int>& component_options() {
 // Mirrored kinematic conditions (kernels/boundary_conditions.hpp). A mirrored Displacement of
 // the normal of its face that is the only kinematic condition reaching its layer points makes
 // the layer the body's mirror image (mirror_kinematic: a symmetry plane). Any other mirrored
-// kinematic condition (a tangential Displacement, a Micro-Rotation, or several on one layer,
-// such as a clamp) slaves the layer (slave_layer): its points carry no strain energy, so every
-// kinematic condition that reaches them must be mirrored too and share their region. Sets
+// kinematic condition (a tangential Displacement, a Velocity, a Micro-Rotation, or several on one
+// layer, such as a clamp) slaves the layer (slave_layer): its points carry no strain energy, so
+// every kinematic condition that reaches them must be mirrored too and share their region. Sets
 // BoundaryCondition::slaved. Thrown on every rank (all read the same input).
+inline std::string kind_name(const BoundaryCondition& bc) {
+  return bc.kind == BoundaryCondition::Displacement ? "Displacement"
+         : bc.kind == BoundaryCondition::Velocity   ? "Velocity"
+                                                    : "Micro-Rotation";
+}
 template <int Dim>
 void check_mirrored_kinematic(const GridSpec<Dim>& g, std::vector<BoundaryCondition>& bcs,
                               const std::string& root, Physics physics, ConstitutiveModel model,
-                              BondBreaking breaking) {
+                              BondBreaking breaking, bool j_contours) {
   const char* axes = "xyz";
   // Whether region mask b reaches the points of region mask a (outside face `axis`) that lie
   // outside that face only: a's box clipped to the body along the other axes. Points sit at
@@ -136,18 +141,16 @@ void check_mirrored_kinematic(const GridSpec<Dim>& g, std::vector<BoundaryCondit
     // pressure is its own unknown, not the mirror image of the body's, so the coupled operator
     // is not symmetric; refused until the layer's water is mirrored too.
     if (physics != Physics::MicropolarSolid)
-      throw InputError(
-          "Error, " + path + "Boundary Layer Values = Mirrored: mirrored " +
-          (bc.kind == BoundaryCondition::Displacement ? "Displacement" : "Micro-Rotation") +
-          " layers need " + root +
-          "->Solver->Physics = Micropolar Solid (with pore water they were measured "
-          "unstable; write Constant).");
+      throw InputError("Error, " + path + "Boundary Layer Values = Mirrored: mirrored " +
+                       kind_name(bc) + " layers need " + root +
+                       "->Solver->Physics = Micropolar Solid (with pore water they were measured "
+                       "unstable; write Constant).");
     const int axis = face_axis(g, bc.region_mask);
     if (axis < 0)
       throw InputError("Error, " + path +
-                       "Boundary Layer Values = Mirrored: a mirrored condition needs a region "
-                       "that lies outside exactly one face of the body (a boundary layer such as "
-                       "'Layer -x').");
+                       "Region: a mirrored condition (Boundary Layer Values = Mirrored) needs a "
+                       "region that lies outside exactly one face of the body (a boundary layer "
+                       "such as 'Layer -x').");
     bool alone = true;
     for (const auto& other : bcs)
       if (&other != &bc && other.kinematic() && overlap(bc.region_mask, axis, other.region_mask))
@@ -158,18 +161,40 @@ void check_mirrored_kinematic(const GridSpec<Dim>& g, std::vector<BoundaryCondit
     // Slaved layers are built and measured for the elastic solid whose bonds stay intact:
     // breakage accumulates bond energies from the increments, which the slaving rewrites
     // (slaved_increment), and the plastic law's state on energy-free points is not defined.
+    // The J-integral's contours may reach into the layers, whose states are zero.
+    const std::string what = "Boundary Layer Values = Mirrored on a " + kind_name(bc) +
+                             (bc.kind == BoundaryCondition::MicroRotation
+                                  ? std::string()
+                                  : std::string(" of component ") + axes[bc.component]) +
+                             " slaves its layer (energy-free points)";
     if (model != ConstitutiveModel::MicropolarElastic || breaking != BondBreaking::None)
-      throw InputError("Error, " + path + "Boundary Layer Values = Mirrored on a " +
-                       (bc.kind == BoundaryCondition::Displacement
-                            ? std::string("Displacement of component ") + axes[bc.component]
-                            : std::string("Micro-Rotation")) +
-                       " slaves its layer (energy-free points), which is implemented for "
-                       "Materials->Model = Micropolar Elastic with Fracture->Bond Breakage = None "
-                       "only; write Constant, or mirror the normal Displacement alone (a "
-                       "symmetry plane).");
+      throw InputError("Error, " + path + what + ", which is implemented for " + root +
+                       "->Materials->Model = Micropolar Elastic with " + root +
+                       "->Fracture->Bond Breakage = None only; write Constant, or mirror the "
+                       "normal Displacement alone (a symmetry plane).");
+    if (j_contours)
+      throw InputError("Error, " + path + what + ", and the J-integral's contours (" + root +
+                       "->J-Integral->Half Widths) may reach into them, where the states are "
+                       "zero; write Constant, or give no contours.");
+    // Each body point must be the mirror of one layer point per face (the fold's one writer).
+    const int side = face_index(g, bc.region_mask) % 2;
+    if (g.counts[axis] < g.layers[axis][side])
+      throw InputError("Error, " + path + "Region: " + what + ", which is " +
+                       std::to_string(g.layers[axis][side]) + " rows thick, but the body is " +
+                       std::to_string(g.counts[axis]) + " rows along " + axes[axis] +
+                       ": a slaved layer needs a body at least as thick as the layer (each body "
+                       "point the mirror of one layer point).");
     for (const auto& other : bcs) {
       if (&other == &bc || !other.kinematic() || !overlap(bc.region_mask, axis, other.region_mask))
         continue;
+      const bool rotation = other.kind == BoundaryCondition::MicroRotation;
+      if (other.mirrored && other.region_mask == bc.region_mask &&
+          rotation == (bc.kind == BoundaryCondition::MicroRotation) &&
+          other.component == bc.component)
+        throw InputError("Error, " + path + "Component: " + root + "->Boundary Conditions->" +
+                         other.name +
+                         " prescribes the same component of the same layer; give "
+                         "each component one condition.");
       if (!other.mirrored || other.region_mask != bc.region_mask)
         throw InputError("Error, " + path +
                          "Boundary Layer Values = Mirrored slaves the points of its layer (they "
@@ -316,7 +341,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
   for (const auto& bc : m.boundary_conditions)
     m.grid.mirrored_layers = m.grid.mirrored_layers || bc.mirrored;
   check_mirrored_kinematic(m.grid, m.boundary_conditions, input.name(), r.physics,
-                           m.constitutive_model, m.fracture.criterion);
+                           m.constitutive_model, m.fracture.criterion, !m.j_integral.half.empty());
   check_fluid_flux(m.grid, m.boundary_conditions, input.name());
   m.initial_conditions = initial_conditions_from_input(input);
   return m;

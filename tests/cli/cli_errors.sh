@@ -163,20 +163,20 @@ cat >>empty_region.xml <<'XML'
 </ParameterList>
 XML
 expect empty_region 2 "mupm->Boundary Conditions->pull->Region = 'outside' holds no point"
-# Mirrored boundary-layer values are for Pore Pressure, Displacement and Micro-Rotation only.
+# Mirrored boundary-layer values are for Pore Pressure and the kinematic conditions only.
 base '<Parameter name="Boundary Layers" type="Array(string)" value="{-x}"/>' '' | sed '$d' >mirrored_kinematic.xml
 cat >>mirrored_kinematic.xml <<'XML'
   <ParameterList name="Boundary Conditions"><ParameterList name="hold">
-    <Parameter name="Type" type="string" value="Velocity"/>
+    <Parameter name="Type" type="string" value="Traction"/>
     <Parameter name="Region" type="string" value="Layer -x"/>
     <Parameter name="Boundary Layer Values" type="string" value="Mirrored"/>
   </ParameterList></ParameterList>
 </ParameterList>
 XML
-expect mirrored_kinematic 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'only Pore Pressure, Displacement and Micro-Rotation'
+expect mirrored_kinematic 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'only Pore Pressure, Displacement, Velocity and Micro-Rotation'
 # A mirrored tangential Displacement slaves its layer (energy-free points), so no condition may
 # hold constant values on the same points.
-sed -e 's|value="Velocity"|value="Displacement"|' \
+sed -e 's|value="Traction"|value="Displacement"|' \
   -e 's|<Parameter name="Region" type="string" value="Layer -x"/>|&<Parameter name="Component" type="string" value="y"/>|' \
   -e 's|</ParameterList></ParameterList>|</ParameterList><ParameterList name="hold2"><Parameter name="Type" type="string" value="Displacement"/><Parameter name="Region" type="string" value="Layer -x"/></ParameterList></ParameterList>|' \
   mirrored_kinematic.xml >mirrored_tangential.xml
@@ -191,7 +191,7 @@ base '<Parameter name="Boundary Layers" type="Array(string)" value="{-x}"/>' \
   '<Parameter name="Physics" type="string" value="Hydro-Mechanical"/>' |
   sed -e '$d' -e 's|<Parameter name="Length Scale" type="double" value="1e-3"/>|&<Parameter name="Porosity" type="double" value="0.2"/>|' -e 's|<ParameterList name="Solver">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/></ParameterList>&|' >mirrored_fluid.xml
 sed -n '/<ParameterList name="Boundary Conditions">/,$p' mirrored_kinematic.xml |
-  sed 's|value="Velocity"|value="Displacement"|' >>mirrored_fluid.xml
+  sed 's|value="Traction"|value="Displacement"|' >>mirrored_fluid.xml
 expect mirrored_fluid 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'mupm->Solver->Physics = Micropolar Solid'
 # Fluid Flux sets its layer by the flux only, and needs a region outside one face.
 sed 's|value="Displacement"|value="Fluid Flux"|' mirrored_fluid.xml >flux_layer_values.xml

@@ -87,13 +87,14 @@ check coupled-flux inputs/consolidation.xml 60 16 's|<ParameterList name="drain 
 # layers): the layers follow their mirrors, which travel with the ghosts.
 check solid-mirrored inputs/quickstart.xml 40 8 's|(<Parameter name="Component" type="string" value="y"/>)|\1<Parameter name="Boundary Layer Values" type="string" value="Mirrored"/>|'
 # Slaved clamps (the quick start's plate pulled through top and bottom layers that hold x, y and
-# the micro-rotation, each Mirrored): energy-free layers that follow their mirrors, whose forces
-# are folded back onto the mirrors across ranks (Distribution::add_to_owners).
-cond() {  # cond NAME LAYER TYPE COMPONENT
-  printf '<ParameterList name="%s"><Parameter name="Type" type="string" value="%s"/><Parameter name="Region" type="string" value="%s"/><Parameter name="Component" type="string" value="%s"/><Parameter name="Boundary Layer Values" type="string" value="Mirrored"/></ParameterList>' "$1" "$3" "$2" "$4"
+# the micro-rotation, each Mirrored; the top one also sheared at 0.05 m/s by a Velocity, whose
+# displacement so far is a restart global): energy-free layers that follow their mirrors, whose
+# forces are folded back onto the mirrors across ranks (Distribution::add_to_owners).
+cond() {  # cond NAME LAYER TYPE COMPONENT [VALUE]
+  printf '<ParameterList name="%s"><Parameter name="Type" type="string" value="%s"/><Parameter name="Region" type="string" value="%s"/><Parameter name="Component" type="string" value="%s"/><Parameter name="Value" type="double" value="%s"/><Parameter name="Boundary Layer Values" type="string" value="Mirrored"/></ParameterList>' "$1" "$3" "$2" "$4" "${5:-0}"
 }
-clamps="$(cond "top x" "Layer +y" Displacement x)$(cond "top rotation" "Layer +y" Micro-Rotation z)$(cond "bottom x" "Layer -y" Displacement x)$(cond "bottom rotation" "Layer -y" Micro-Rotation z)"
-check solid-clamped inputs/quickstart.xml 40 8 "s|(<Parameter name=\"Component\" type=\"string\" value=\"y\"/>)|\\1<Parameter name=\"Boundary Layer Values\" type=\"string\" value=\"Mirrored\"/>|; s|(<ParameterList name=\"Boundary Conditions\">)|\\1$clamps|"
+clamps="$(cond "top x" "Layer +y" Velocity x 0.05)$(cond "top rotation" "Layer +y" Micro-Rotation z)$(cond "bottom x" "Layer -y" Displacement x)$(cond "bottom rotation" "Layer -y" Micro-Rotation z)"
+check solid-clamped inputs/quickstart.xml 40 9 "s|(<Parameter name=\"Component\" type=\"string\" value=\"y\"/>)|\\1<Parameter name=\"Boundary Layer Values\" type=\"string\" value=\"Mirrored\"/>|; s|(<ParameterList name=\"Boundary Conditions\">)|\\1$clamps|"
 check fracture tests/cli/fracture_small.xml 440 11
 # The J criterion (Algorithm 3): the crack advances by increments from step ~200.
 check fracture-j tests/cli/fracture_small.xml 440 13 's|value="Energy"/>|value="J-Integral"/>|; s|  <ParameterList name="Boundary Conditions">|  <ParameterList name="J-Integral"><Parameter name="Half Widths" type="Array(double)" value="{4, 5}"/></ParameterList>\n&|'

@@ -5,6 +5,7 @@
 #include <Teuchos_Array.hpp>
 
 #include "mupm/input/input.hpp"
+#include "mupm/input/model.hpp"
 
 namespace mupm {
 namespace {
@@ -182,6 +183,59 @@ TEST(Input, NumbersAreReadStrictly) {
                {"mupm->Solver->Number of Steps", "not a finite int"});
   expect_error(xml(kOk + "<Parameter name=\"Horizon\" type=\"double\" value=\"nan\"/>"),
                {"mupm->Discretization->Horizon", "nan"});
+}
+
+// Mirrored kinematic conditions (input/model.cpp, check_mirrored_kinematic): a lone normal
+// Displacement is a symmetry plane, a clamp (x, y and the rotation, each Mirrored) is slaved,
+// and the slaved layer's conditions are checked (a repeated component, a layer thicker than the
+// body).
+TEST(Input, MirroredKinematicConditions) {
+  auto cond = [](const std::string& name, const std::string& layer, const std::string& type,
+                 const std::string& component) {
+    return "<ParameterList name=\"" + name +
+           "\"><Parameter name=\"Type\" type=\"string\" value=\"" + type +
+           "\"/><Parameter name=\"Region\" type=\"string\" value=\"" + layer +
+           "\"/><Parameter name=\"Component\" type=\"string\" value=\"" + component +
+           "\"/><Parameter name=\"Boundary Layer Values\" type=\"string\" value=\"Mirrored\"/>"
+           "</ParameterList>";
+  };
+  auto input = [&](const std::string& conditions, const std::string& counts = "{10, 8}") {
+    return xml(
+        "<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
+        "<Parameter name=\"Counts\" type=\"Array(int)\" value=\"" +
+            counts +
+            "\"/>"
+            "<Parameter name=\"Boundary Layers\" type=\"Array(string)\" value=\"{-y, +y}\"/>",
+        "<ParameterList name=\"Boundary Conditions\">" + conditions + "</ParameterList>");
+  };
+  const std::string clamp = cond("bx", "Layer -y", "Displacement", "x") +
+                            cond("by", "Layer -y", "Displacement", "y") +
+                            cond("br", "Layer -y", "Micro-Rotation", "z");
+  auto pl = parse_input(input(clamp + cond("top", "Layer +y", "Displacement", "y")));
+  validate_input(*pl);
+  const auto m = model_from_input<2>(*pl);
+  ASSERT_EQ(m.boundary_conditions.size(), 4u);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_TRUE(m.boundary_conditions[k].slaved) << m.boundary_conditions[k].name;
+  EXPECT_TRUE(m.boundary_conditions[3].mirrored);
+  EXPECT_FALSE(m.boundary_conditions[3].slaved);  // alone and normal: the symmetry plane
+  EXPECT_TRUE(m.grid.mirrored_layers);
+  auto refused = [&](const std::string& text, const std::vector<std::string>& expect) {
+    try {
+      auto bad = parse_input(text);
+      validate_input(*bad);
+      model_from_input<2>(*bad);
+      ADD_FAILURE() << "no error for:\n" << text;
+    } catch (const InputError& e) {
+      for (const auto& piece : expect)
+        EXPECT_NE(std::string(e.what()).find(piece), std::string::npos) << e.what();
+    }
+  };
+  refused(input(clamp + cond("bx2", "Layer -y", "Displacement", "x")),
+          {"mupm->Boundary Conditions->bx->Component", "bx2 prescribes the same component"});
+  // Layers as thick as the default (more than 2 rows) on a body 2 rows high.
+  refused(input(clamp, "{10, 2}"),
+          {"mupm->Boundary Conditions->bx->Region", "rows thick, but the body is 2 rows along y"});
 }
 
 TEST(Input, SolidAndBoundaryConditions) {

@@ -241,26 +241,24 @@ void mark_mirrored_fixed(const std::vector<BoundaryCondition>& bcs, const Points
   }
 }
 
-// Slaved boundary layers (the boundary-layer issue; a clamp, u = theta = 0 at the face, is the
+// Slaved boundary layers (README "Boundary layers"; a clamp, u = theta = 0 at the face, is the
 // case they are for). The points of the layer that lie outside its face only carry no strain
 // energy (kFixedNoEnergy: pass 1 gives them zero states, include/mupm/kernels/solid.hpp), so the
 // body's energy Psi is its real points' alone. Each prescribed component c of a layer point L
 // takes the odd reflection of its mirror m (the body point at the same distance inside):
-//   v_c(L) = 2 g - v_c(m)   (u, theta, and their rates),
+//   q_c(L) = 2 g - q_c(m)   (q = u or theta; the velocity likewise),
 // so that the nonlocal gradients see a field that passes through g at the face. The force the
 // body's states put on L, f_L = -(dPsi/du_L) / V_L, is folded back onto the mirror by the chain
-// rule of u_L = 2 g - u_m (fold_layer_forces): f_m -= f_L V_L / V_m. The operator on the real
-// points is then P^T K P, K the stiffness of Psi and P the (affine) slaving: symmetric and
-// positive semi-definite for any reflection, so the explicit scheme stays stable; an odd
-// reflection of layers that keep their own energy is neither, and was measured to grow without
-// bound. The boundary's generalized force is dPsi/dg = -2 sum_L f_L V_L (the reaction, and
-// the external work on the increment 2 dg: slaved_increment). Components of the layer without
-// a condition stay free (energy-free points that the body's gradients see and move).
-// Measured (the Cosserat layer of VALIDATION section 3 sheared between two clamps, h/dx = 20,
-// 40, 80): shear-stress error +3.90 / +1.20 / +0.32 % (second order); holding the constant g
-// in the layer (the paper's): -7.64 / -4.74 / -2.80 % (first order, the layer acts ~0.7 delta
-// outside the face). Corner (and 3D edge) points of the region are not slaved: they hold g and
-// keep their energy (apply_kinematic).
+// rule of u_L = 2 g - u_m (pack_layer_forces, add_folded): f_m -= f_L V_L / V_m. The operator on
+// the real points is then P^T K P, K the stiffness of Psi and P the (affine) slaving: symmetric and
+// positive semi-definite for any reflection, so the explicit scheme stays stable (an odd
+// reflection of layers that keep their own energy is neither). The boundary's generalized force
+// is dPsi/dg = -2 sum_L f_L V_L (the reaction, and the external work on the increment 2 dg:
+// slaved_increment). Components of the layer without a condition stay free (energy-free points
+// that the body's gradients see and move). Corner (and 3D edge) points of the region are not
+// slaved: they hold g and keep their energy (apply_kinematic). The layer must not be thicker
+// than the body along its normal (input/model.cpp), so that each body point is the mirror of at
+// most one layer point per face.
 template <int Dim>
 void mark_slaved(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts,
                  const View2<LocalId>& mirror) {
@@ -278,19 +276,21 @@ void mark_slaved(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& p
   }
 }
 
-// The odd reflection v_c(L) = 2 g(t) - v_c(m) of a slaved condition's component on its layer
-// points (header above), for u (theta) and v; the mirrors must be current on the ghosts.
-// `homogeneous`: g = 0 (the linear operator, for the stable-step estimate). The micro-rotation
-// rate of a slaved rotation is set to g' (it is not ghosted; a prescribed component carries no
-// kinetic energy, so it is output only).
+// The odd reflection v_c(L) = 2 g - v_c(m) of a slaved condition's component on its layer
+// points (header above), for u (theta) and v; the mirrors must be current on the ghosts. g, g_rate:
+// the prescribed displacement (rotation) and its rate at this time: value g(t) and value g'(t) for
+// Displacement and Micro-Rotation, the displacement integrated so far and value g(t) for Velocity
+// (SolidSolver), 0 for the linear operator (the stable-step estimate). The micro-rotation rate of
+// a slaved rotation is set to g_rate (it is not ghosted; a prescribed component carries no kinetic
+// energy, so it is output only).
+// `rates` = false: u (theta) only, the velocities and accelerations left as they are (the
+// stable-step estimate's iterates, g = 0).
 template <int Dim>
 void slave_layer(const BoundaryCondition& bc, const Points<Dim>& pts, const View2<LocalId>& mirror,
-                 double t, bool homogeneous = false) {
+                 double g, double g_rate, bool rates = true) {
   const bool rot = bc.kind == BoundaryCondition::MicroRotation;
   const std::uint32_t mask = bc.region_mask;
   const int c = bc.component;
-  const double g = homogeneous ? 0.0 : bc.value * bc.time(t);
-  const double g_rate = homogeneous ? 0.0 : bc.value * bc.time.rate(t);
   auto regions = pts.regions;
   auto fixed = pts.fixed;
   auto q = rot ? pts.theta : pts.u, dq = rot ? pts.omega : pts.v, ddq = rot ? pts.alpha : pts.a;
@@ -300,28 +300,29 @@ void slave_layer(const BoundaryCondition& bc, const Points<Dim>& pts, const View
           return;
         const LocalId m = mirror(i, Dim);
         q(i, c) = 2 * g - q(m, c);
+        if (!rates)
+          return;
         dq(i, c) = rot ? g_rate : 2 * g_rate - dq(m, c);
         ddq(i, c) = 0;
       });
 }
 
-// The increment the boundary works on in a step from t to t + dt: 2 (g(t + dt) - g(t)) on a
-// slaved condition's component (dPsi/dg = -2 sum f_L V_L; the layer point's own increment
-// 2 dg - du_m is not what the boundary moves). Written into the step's increments `du`
+// The increment the boundary works on in a step: 2 dg on a slaved condition's component
+// (dPsi/dg = -2 sum f_L V_L; the layer point's own increment 2 dg - du_m is not what the
+// boundary moves), `twice_dg` = 2 dg. Written into the step's increments `du`
 // ([point][Dim + R]), which then serve the external work only (slaved layers are refused with
 // bond breakage, whose bond energies use the increments too).
 template <int Dim>
 void slaved_increment(const BoundaryCondition& bc, const Points<Dim>& pts, const Vectors& du,
-                      double t, double dt) {
+                      double twice_dg) {
   const std::uint32_t mask = bc.region_mask;
   const int c = bc.kind == BoundaryCondition::MicroRotation ? Dim + bc.component : bc.component;
-  const double dg = 2 * bc.value * (bc.time(t + dt) - bc.time(t));
   auto regions = pts.regions;
   auto fixed = pts.fixed;
   Kokkos::parallel_for(
       "mupm::BC::slaved_increment", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         if ((mask == 0 || (regions(i) & mask)) && (fixed(i) & kFixedNoEnergy))
-          du(i, c) = dg;
+          du(i, c) = twice_dg;
       });
 }
 
@@ -353,7 +354,10 @@ void pack_layer_forces(const Points<Dim>& pts, const View2<LocalId>& mirror, con
           if (mirror(i, d) >= 0)
             axis = d;
         const int side = (flags(i) & layer_face_flag(axis, 1)) ? 1 : 0;
-        const int c0 = slot[2 * axis + side] * N;
+        const int block = slot[2 * axis + side];
+        if (block < 0)  // a face without slaved conditions (every slaved face has a block)
+          return;
+        const int c0 = block * N;
         const double s = vol(i) / vol(m);
         for (int c = 0; c < N; ++c)
           if (fx & (1u << c))

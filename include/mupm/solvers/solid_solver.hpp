@@ -44,6 +44,19 @@ void solid_forces(Discretization<Dim>& disc, const SolidParams& prm, SolidState<
   solid_forces(disc, prm, prm.law, st);
 }
 
+// The fold of the slaved layers' forces and moments onto their mirrors
+// (kernels/boundary_conditions.hpp): buf ([owned + ghosts][blocks * (Dim + R)]) zeroed, packed,
+// its ghost rows added into their owners across ranks, added to the owned points' force, moment.
+template <int Dim>
+void fold_layer_forces(Discretization<Dim>& disc, const FaceSlots& slots, const Vectors& force,
+                       const Vectors& moment, const Vectors& buf) {
+  Kokkos::deep_copy(buf, 0.0);
+  pack_layer_forces(disc.points, disc.mirror, slots, force, moment, buf);
+  disc.dist.add_to_owners(buf);
+  add_folded(disc.points, buf, force, moment);
+  Kokkos::fence();
+}
+
 // What the solid solver takes besides the law's parameters (the same for every law).
 struct SolidSettings {
   double rho_s = 2000, rho_w = 1000;
@@ -103,6 +116,7 @@ class SolidSolver : public Mechanics {
         if (bc.slaved && slots_[face] < 0)
           slots_[face] = blocks++;
       }
+    slaved_disp_.assign(bcs_.size(), 0.0);
     auto& p = disc_.points;
     if (slaved_)
       fold_ = Vectors("mupm::layer_fold", p.size(), std::size_t(blocks * (Dim + R)));
@@ -163,6 +177,9 @@ class SolidSolver : public Mechanics {
     }
     if constexpr (Law::plastic)
       g("plastic_dissipation", plastic_dissipation_);
+    for (std::size_t k = 0; k < bcs_.size(); ++k)
+      if (slaved_velocity(bcs_[k]))
+        g("slaved_displacement_" + bcs_[k].name, slaved_disp_[k]);
     if (set_.second_order_window > 0) {
       g("steps", steps_);
       g("negative_second_order_work_fraction", negative_fraction_);
@@ -278,12 +295,22 @@ class SolidSolver : public Mechanics {
     save_positions();
     advance_positions(p, dt);
     apply_kinematic(bcs_, p, t, dt);
+    std::vector<double> twice_dg(bcs_.size(), 0.0);  // of the slaved conditions
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      const auto& bc = bcs_[k];
+      if (slaved_velocity(bc)) {  // the displacement of apply_kinematic's midpoint rule
+        const double before = slaved_disp_[k];
+        slaved_disp_[k] += dt * bc.value * bc.time(t + 0.5 * dt);
+        twice_dg[k] = 2 * (slaved_disp_[k] - before);
+      } else if (bc.kinematic() && bc.slaved) {
+        twice_dg[k] = 2 * bc.value * (bc.time(t + dt) - bc.time(t));
+      }
+    }
     mirror_layers(t + dt);
     increments();
-    if (slaved_)
-      for (const auto& bc : bcs_)
-        if (bc.kinematic() && bc.slaved)
-          slaved_increment(bc, p, du_, t, dt);
+    for (std::size_t k = 0; k < bcs_.size(); ++k)
+      if (bcs_[k].kinematic() && bcs_[k].slaved)
+        slaved_increment(bcs_[k], p, du_, twice_dg[k]);
     // Work, dissipation, pore work and bond breakage of the step (this rank's points), then one
     // reduction.
     // w[0]: the external work, w[6]: the crack force's share of it, both by the trapezoid rule
@@ -556,7 +583,7 @@ class SolidSolver : public Mechanics {
           if (slaved_) {  // the slaving's linear part (g = 0), then its fold: P^T K P
             for (const auto& bc : bcs_)
               if (bc.kinematic() && bc.slaved)
-                slave_layer(bc, p, disc_.mirror, 0.0, true);
+                slave_layer(bc, p, disc_.mirror, 0.0, 0.0, false);
             disc_.dist.refresh({p.u, p.theta});
           }
           solid_forces(disc_, prm_, prm_.law, st_);  // elastic: the stiffest tangent, no state
@@ -576,6 +603,7 @@ class SolidSolver : public Mechanics {
     Kokkos::deep_copy(p.vol_strain_ref, ref0);
     disc_.dist.refresh({p.u, p.theta});
     solid_forces(disc_, prm_, law_, st_);
+    fold_layers();
     st_.work = work;
     // The forces the run applied last, not those of the pressure the fluid has updated since
     // (the next step's external work starts from them).
@@ -619,9 +647,20 @@ class SolidSolver : public Mechanics {
       return;
     auto& p = disc_.points;
     disc_.dist.refresh({p.u, p.theta, p.v});
-    for (const auto& bc : bcs_)
-      if (bc.kinematic() && bc.mirrored)
-        bc.slaved ? slave_layer(bc, p, disc_.mirror, t) : mirror_kinematic(bc, p, disc_.mirror, t);
+    for (std::size_t k = 0; k < bcs_.size(); ++k) {
+      const auto& bc = bcs_[k];
+      if (!(bc.kinematic() && bc.mirrored))
+        continue;
+      if (!bc.slaved)
+        mirror_kinematic(bc, p, disc_.mirror, t);
+      else if (slaved_velocity(bc))
+        slave_layer(bc, p, disc_.mirror, slaved_disp_[k], bc.value * bc.time(t));
+      else
+        slave_layer(bc, p, disc_.mirror, bc.value * bc.time(t), bc.value * bc.time.rate(t));
+    }
+  }
+  static bool slaved_velocity(const BoundaryCondition& bc) {
+    return bc.slaved && bc.kind == BoundaryCondition::Velocity;
   }
   // The slaved layer points' forces and moments onto their mirrors (pack_layer_forces), across
   // ranks. The layer points keep theirs: the reactions and the external work are made of them.
@@ -629,11 +668,7 @@ class SolidSolver : public Mechanics {
     if (!slaved_)
       return;
     ScopedRegion region("mupm::Solid::fold_layers");
-    auto& p = disc_.points;
-    Kokkos::deep_copy(fold_, 0.0);
-    pack_layer_forces(p, disc_.mirror, slots_, st_.force, st_.moment, fold_);
-    disc_.dist.add_to_owners(fold_);
-    add_folded(p, fold_, st_.force, st_.moment);
+    fold_layer_forces(disc_, slots_, st_.force, st_.moment, fold_);
   }
 
   void forces(double t) {
@@ -879,15 +914,18 @@ class SolidSolver : public Mechanics {
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
   double crack_work_ = 0;       // work of the crack water's face forces since t = 0 [J] (Energy)
   double fracture_energy_ = 0;  // strain energy lost to bond breakage since t = 0 [J]
-  double plastic_dissipation_ = 0;          // plastic dissipation since t = 0 [J] (plastic law)
-  double steps_ = 0;                        // steps since t = 0 (second-order work windows)
-  double negative_fraction_ = 0;            // volume fraction with d2E < 0, last window
-  double bond_energy_released_ = 0;         // W V_i V_j of the bonds broken since t = 0 [J]
-  double broken_pairs_ = 0;                 // bond pairs broken since t = 0 (a restart global)
-  bool mirrored_ = false;                   // mirrored Displacement conditions (mirror_layers)
-  bool slaved_ = false;                     // slaved layers (slave_layer, fold_layers)
-  Vectors fold_;                            // fold_layers' buffer [owned + ghosts][columns]
-  FaceSlots slots_;                         // fold_'s block of each face (-1: none)
+  double plastic_dissipation_ = 0;   // plastic dissipation since t = 0 [J] (plastic law)
+  double steps_ = 0;                 // steps since t = 0 (second-order work windows)
+  double negative_fraction_ = 0;     // volume fraction with d2E < 0, last window
+  double bond_energy_released_ = 0;  // W V_i V_j of the bonds broken since t = 0 [J]
+  double broken_pairs_ = 0;          // bond pairs broken since t = 0 (a restart global)
+  bool mirrored_ = false;            // mirrored Displacement conditions (mirror_layers)
+  bool slaved_ = false;              // slaved layers (slave_layer, fold_layers)
+  Vectors fold_;                     // fold_layers' buffer [owned + ghosts][columns]
+  FaceSlots slots_;                  // fold_'s block of each face (-1: none)
+  // The displacement a slaved Velocity condition has prescribed since t = 0 (by condition; a
+  // restart global), the g its layer reflects about.
+  std::vector<double> slaved_disp_;
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
   bool keep_pore_part_ = false;             // P1w for the J-integral (keep_pore_part)
   std::function<Breakage(double)> driver_;  // the J criterion (set_crack_driver), at time t
