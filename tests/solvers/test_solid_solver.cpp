@@ -124,12 +124,13 @@ TEST(SolidSolver, BarUnderTraction) {
 // image about u_x = g, mirror_kinematic) reproduce the uniform stretch, which is symmetric about
 // both faces, exactly when the layers are 2 delta thick (`horizons` = 2): then every layer point
 // that bonds to the body has a whole family, and its force state is the body's.
-double end_displacement_bar(bool mirrored, int horizons, double& reaction_ratio) {
-  const double dx = 2.5e-3, U = 1e-5;
+// The 40 x 8 bar of spacing dx with layers `horizons` horizons thick at both ends (regions
+// "left" and "right": the layer points beyond x = 0 and x = L).
+GridSpec<2> end_layer_bar(double dx, int horizons, bool mirrored) {
   auto g = test::box<2>({40, 8}, 3.015, dx);
   g.layers[0] = {horizons * g.horizon_cells(), horizons * g.horizon_cells()};
   g.mirrored_layers = mirrored;
-  const double L = 40 * dx, H = 8 * dx;
+  const double L = 40 * dx;
   Box left, right;
   left.lo[0] = left.lo[1] = right.lo[1] = -1;
   left.hi[0] = -0.25 * dx;
@@ -137,6 +138,13 @@ double end_displacement_bar(bool mirrored, int horizons, double& reaction_ratio)
   right.lo[0] = L + 0.25 * dx;
   g.region_names = {"left", "right"};
   g.regions = {left, right};
+  return g;
+}
+
+double end_displacement_bar(bool mirrored, int horizons, double& reaction_ratio) {
+  const double dx = 2.5e-3, U = 1e-5;
+  const auto g = end_layer_bar(dx, horizons, mirrored);
+  const double L = 40 * dx, H = 8 * dx;
   BoundaryCondition hold, pull;
   hold.name = "hold";
   hold.kind = pull.kind = BoundaryCondition::Displacement;
@@ -206,17 +214,8 @@ std::vector<BoundaryCondition> clamps(const std::string& first, const std::strin
 double clamped_bar(bool slaved, double& reaction_ratio) {
   const double dx = 2.5e-3, U = 1e-5;
   const MicropolarElastic law{0.0, 220.33e6, 100e6, 7.5e-3};
-  auto g = test::box<2>({40, 8}, 3.015, dx);
-  g.layers[0] = {g.horizon_cells(), g.horizon_cells()};
-  g.mirrored_layers = slaved;
+  const auto g = end_layer_bar(dx, 1, slaved);
   const double L = 40 * dx, H = 8 * dx;
-  Box left, right;
-  left.lo[0] = left.lo[1] = right.lo[1] = -1;
-  left.hi[0] = -0.25 * dx;
-  left.hi[1] = right.hi[1] = right.hi[0] = 1;
-  right.lo[0] = L + 0.25 * dx;
-  g.region_names = {"left", "right"};
-  g.regions = {left, right};
   auto bcs = clamps("left", "right", slaved);
   bcs[3].value = U;  // right_x
   bcs[3].time.kind = TimeFunction::Ramp;

@@ -14,6 +14,23 @@ namespace {
 
 using test::Body;
 
+// The closed form of VALIDATION.md section 3: the micropolar layer 0 <= y <= h in simple shear
+// by the traction tau on its faces (B = mu l^2 / 2, alpha^2 = 4 mu mu_c / ((mu + mu_c) B)).
+struct CosseratShear {
+  double mu = 10e6, mu_c = 5e6, l = 0.01, h = 0.1, tau = 10e3, lambda = 10e6;
+  double alpha() const { return std::sqrt(4 * mu * mu_c / ((mu + mu_c) * (mu * l * l / 2))); }
+  double theta(double y) const {
+    const double a = alpha();
+    return -(tau / (2 * mu)) * (1 - std::cosh(a * (y - h / 2)) / std::cosh(a * h / 2));
+  }
+  double u(double y) const {
+    const double a = alpha();
+    return tau * y / mu - mu_c * tau / (mu * (mu + mu_c) * a) *
+                              (std::sinh(a * (y - h / 2)) + std::sinh(a * h / 2)) /
+                              std::cosh(a * h / 2);
+  }
+};
+
 // Dynamic relaxation with mass-proportional damping c until steps are done.
 template <int Dim>
 void relax(Body<Dim>& body, double dt, double damping, int steps) {
@@ -47,18 +64,11 @@ void fix(Body<Dim>& body, std::uint32_t mask, std::function<bool(const double*)>
 // The boundary layers (3 rows outside every face) hold the closed form itself, so the interior
 // must relax to it: a layer infinite in x, loaded on its faces.
 TEST(SolidValidation, CosseratLayerSimpleShear) {
-  const double mu = 10e6, mu_c = 5e6, l = 0.01, h = 0.1, tau = 10e3, lambda = 10e6;
-  const double B = mu * l * l / 2;
-  const double alpha = std::sqrt(4 * mu * mu_c / ((mu + mu_c) * B));
-  ASSERT_NEAR(alpha, 163.299, 1e-3);  // the reference number of VALIDATION.md
-  auto theta_exact = [&](double y) {
-    return -(tau / (2 * mu)) * (1 - std::cosh(alpha * (y - h / 2)) / std::cosh(alpha * h / 2));
-  };
-  auto u_exact = [&](double y) {
-    return tau * y / mu - mu_c * tau / (mu * (mu + mu_c) * alpha) *
-                              (std::sinh(alpha * (y - h / 2)) + std::sinh(alpha * h / 2)) /
-                              std::cosh(alpha * h / 2);
-  };
+  const CosseratShear cs;
+  const double mu = cs.mu, mu_c = cs.mu_c, l = cs.l, h = cs.h, lambda = cs.lambda;
+  ASSERT_NEAR(cs.alpha(), 163.299, 1e-3);  // the reference number of VALIDATION.md
+  auto theta_exact = [&](double y) { return cs.theta(y); };
+  auto u_exact = [&](double y) { return cs.u(y); };
   EXPECT_NEAR(theta_exact(h / 2), -4.9972e-4, 1e-8);
   EXPECT_NEAR(u_exact(h), 9.5918e-5, 1e-9);
 
@@ -127,17 +137,10 @@ struct ClampedLayer {
   double stiffness_ratio = 0;  // G_eff / mu = tau h / (mu u(h)): driven from the reaction
 };
 ClampedLayer cosserat_layer_between_layers(bool slaved, bool driven, int per_h) {
-  const double mu = 10e6, mu_c = 5e6, l = 0.01, h = 0.1, tau = 10e3, lambda = 10e6;
-  const double B = mu * l * l / 2;
-  const double alpha = std::sqrt(4 * mu * mu_c / ((mu + mu_c) * B));
-  auto theta_exact = [&](double y) {
-    return -(tau / (2 * mu)) * (1 - std::cosh(alpha * (y - h / 2)) / std::cosh(alpha * h / 2));
-  };
-  auto u_exact = [&](double y) {
-    return tau * y / mu - mu_c * tau / (mu * (mu + mu_c) * alpha) *
-                              (std::sinh(alpha * (y - h / 2)) + std::sinh(alpha * h / 2)) /
-                              std::cosh(alpha * h / 2);
-  };
+  const CosseratShear cs;
+  const double mu = cs.mu, mu_c = cs.mu_c, l = cs.l, h = cs.h, tau = cs.tau, lambda = cs.lambda;
+  auto theta_exact = [&](double y) { return cs.theta(y); };
+  auto u_exact = [&](double y) { return cs.u(y); };
   const double U = u_exact(h), dx = h / per_h;
   const int cols = 2;
   const double W = cols * dx;
@@ -209,7 +212,7 @@ ClampedLayer cosserat_layer_between_layers(bool slaved, bool driven, int per_h) 
   fix(body, kFixedNoEnergy, outside);
   mark_fixed(bcs, p);
   if (slaved)
-    mark_slaved(bcs, p, body.disc.mirror);
+    mark_mirrored_layers(bcs, p, body.disc.mirror);
   auto set_layers = [&] {
     if (slaved)
       for (const auto& bc : bcs)
@@ -310,11 +313,8 @@ TEST(SolidValidation, CosseratLayerBetweenSlavedClamps) {
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   if (ranks > 1)
     GTEST_SKIP() << "periodic images need the whole layer on one rank";
-  const double mu = 10e6, mu_c = 5e6, l = 0.01, h = 0.1, tau = 10e3;
-  const double alpha = std::sqrt(4 * mu * mu_c / ((mu + mu_c) * (mu * l * l / 2)));
-  const double u_h =
-      tau * h / mu - mu_c * tau / (mu * (mu + mu_c) * alpha) * 2 * std::tanh(alpha * h / 2);
-  const double stiffness = tau * h / (mu * u_h);
+  const CosseratShear cs;
+  const double stiffness = cs.tau * cs.h / (cs.mu * cs.u(cs.h));
   EXPECT_NEAR(stiffness, 1.0426, 1e-4);  // VALIDATION.md's reference number
   for (const bool driven : {true, false}) {
     ClampedLayer r[2];
@@ -406,7 +406,7 @@ void slaved_patch_test(double gamma) {
       bcs.push_back(bc);
     }
   mark_fixed(bcs, p);
-  mark_slaved(bcs, p, body.disc.mirror);
+  mark_mirrored_layers(bcs, p, body.disc.mirror);
   // The real points (owned and ghosts) hold the field; the layers get it from the slaving only.
   body.set([&](const double* x, double* u, double* t) {
     if (x[0] > 0 && x[0] < L)

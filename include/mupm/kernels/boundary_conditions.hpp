@@ -221,26 +221,6 @@ void mirror_kinematic(const BoundaryCondition& bc, const Points<Dim>& pts,
       });
 }
 
-// Marks every component of the mirrored (not slaved) Displacement conditions' layer points
-// prescribed (mirror_kinematic sets them all).
-template <int Dim>
-void mark_mirrored_fixed(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts,
-                         const View2<LocalId>& mirror) {
-  constexpr std::uint32_t all = (1u << (Dim + kRotDim<Dim>)) - 1;
-  for (const auto& bc : bcs) {
-    if (!(bc.kinematic() && bc.mirrored) || bc.slaved)
-      continue;
-    const std::uint32_t mask = bc.region_mask;
-    auto regions = pts.regions;
-    auto fixed = pts.fixed;
-    Kokkos::parallel_for(
-        "mupm::BC::mark_mirrored", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-          if ((mask == 0 || (regions(i) & mask)) && mirror(i, Dim) >= 0)
-            fixed(i) |= all;
-        });
-  }
-}
-
 // Slaved boundary layers (README "Boundary layers"; a clamp, u = theta = 0 at the face, is the
 // case they are for). The points of the layer that lie outside its face only carry no strain
 // energy (kFixedNoEnergy: pass 1 gives them zero states, include/mupm/kernels/solid.hpp), so the
@@ -259,19 +239,24 @@ void mark_mirrored_fixed(const std::vector<BoundaryCondition>& bcs, const Points
 // slaved: they hold g and keep their energy (apply_kinematic). The layer must not be thicker
 // than the body along its normal (input/model.cpp), so that each body point is the mirror of at
 // most one layer point per face.
+
+// Marks the layer points (outside exactly one face) of the mirrored kinematic conditions: every
+// component prescribed for a symmetry plane (mirror_kinematic sets them all), kFixedNoEnergy for
+// a slaved layer (its components are marked by their own conditions, mark_fixed).
 template <int Dim>
-void mark_slaved(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts,
-                 const View2<LocalId>& mirror) {
+void mark_mirrored_layers(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts,
+                          const View2<LocalId>& mirror) {
+  constexpr std::uint32_t all = (1u << (Dim + kRotDim<Dim>)) - 1;
   for (const auto& bc : bcs) {
-    if (!(bc.kinematic() && bc.slaved))
+    if (!(bc.kinematic() && bc.mirrored))
       continue;
-    const std::uint32_t mask = bc.region_mask;
+    const std::uint32_t mask = bc.region_mask, bits = bc.slaved ? kFixedNoEnergy : all;
     auto regions = pts.regions;
     auto fixed = pts.fixed;
     Kokkos::parallel_for(
-        "mupm::BC::mark_slaved", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        "mupm::BC::mark_mirrored", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
           if ((mask == 0 || (regions(i) & mask)) && mirror(i, Dim) >= 0)
-            fixed(i) |= kFixedNoEnergy;
+            fixed(i) |= bits;
         });
   }
 }
@@ -347,7 +332,8 @@ void pack_layer_forces(const Points<Dim>& pts, const View2<LocalId>& mirror, con
       "mupm::BC::pack_layer_forces", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         const std::uint32_t fx = fixed(i);
         const LocalId m = mirror(i, Dim);
-        if (!(fx & kFixedNoEnergy) || m < 0)  // (mark_slaved marks points with a mirror only)
+        if (!(fx & kFixedNoEnergy) ||
+            m < 0)  // (mark_mirrored_layers marks points with a mirror only)
           return;
         int axis = 0;
         for (int d = 0; d < Dim; ++d)

@@ -117,6 +117,7 @@ class SolidSolver : public Mechanics {
           slots_[face] = blocks++;
       }
     slaved_disp_.assign(bcs_.size(), 0.0);
+    twice_dg_.assign(bcs_.size(), 0.0);
     auto& p = disc_.points;
     if (slaved_)
       fold_ = Vectors("mupm::layer_fold", p.size(), std::size_t(blocks * (Dim + R)));
@@ -249,10 +250,8 @@ class SolidSolver : public Mechanics {
   void initialize(double t, bool restarted) override {
     auto& p = disc_.points;
     mark_fixed(bcs_, p);
-    if (mirrored_)
-      mark_mirrored_fixed(bcs_, p, disc_.mirror);
-    if (slaved_)
-      mark_slaved(bcs_, p, disc_.mirror);
+    if (mirrored_ || slaved_)
+      mark_mirrored_layers(bcs_, p, disc_.mirror);
     update_density();
     // Pore water pressure, for the whole run: a fluid (undrained modulus set from the start), or
     // a held initial pressure (without a fluid p never changes). The effective force state's
@@ -295,22 +294,23 @@ class SolidSolver : public Mechanics {
     save_positions();
     advance_positions(p, dt);
     apply_kinematic(bcs_, p, t, dt);
-    std::vector<double> twice_dg(bcs_.size(), 0.0);  // of the slaved conditions
-    for (std::size_t k = 0; k < bcs_.size(); ++k) {
-      const auto& bc = bcs_[k];
-      if (slaved_velocity(bc)) {  // the displacement of apply_kinematic's midpoint rule
-        const double before = slaved_disp_[k];
-        slaved_disp_[k] += dt * bc.value * bc.time(t + 0.5 * dt);
-        twice_dg[k] = 2 * (slaved_disp_[k] - before);
-      } else if (bc.kinematic() && bc.slaved) {
-        twice_dg[k] = 2 * bc.value * (bc.time(t + dt) - bc.time(t));
+    if (slaved_)  // 2 dg of each slaved condition (twice_dg_)
+      for (std::size_t k = 0; k < bcs_.size(); ++k) {
+        const auto& bc = bcs_[k];
+        if (slaved_velocity(bc)) {  // the displacement of apply_kinematic's midpoint rule
+          const double before = slaved_disp_[k];
+          slaved_disp_[k] += dt * bc.value * bc.time(t + 0.5 * dt);
+          twice_dg_[k] = 2 * (slaved_disp_[k] - before);
+        } else if (bc.kinematic() && bc.slaved) {
+          twice_dg_[k] = 2 * bc.value * (bc.time(t + dt) - bc.time(t));
+        }
       }
-    }
     mirror_layers(t + dt);
     increments();
-    for (std::size_t k = 0; k < bcs_.size(); ++k)
-      if (bcs_[k].kinematic() && bcs_[k].slaved)
-        slaved_increment(bcs_[k], p, du_, twice_dg[k]);
+    if (slaved_)
+      for (std::size_t k = 0; k < bcs_.size(); ++k)
+        if (bcs_[k].kinematic() && bcs_[k].slaved)
+          slaved_increment(bcs_[k], p, du_, twice_dg_[k]);
     // Work, dissipation, pore work and bond breakage of the step (this rank's points), then one
     // reduction.
     // w[0]: the external work, w[6]: the crack force's share of it, both by the trapezoid rule
@@ -926,6 +926,7 @@ class SolidSolver : public Mechanics {
   // The displacement a slaved Velocity condition has prescribed since t = 0 (by condition; a
   // restart global), the g its layer reflects about.
   std::vector<double> slaved_disp_;
+  std::vector<double> twice_dg_;            // 2 dg of each slaved condition in the current step
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
   bool keep_pore_part_ = false;             // P1w for the J-integral (keep_pore_part)
   std::function<Breakage(double)> driver_;  // the J criterion (set_crack_driver), at time t
