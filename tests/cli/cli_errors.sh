@@ -289,6 +289,16 @@ grep -qF "WARNING: ranks on one node share cores while OMP_PROC_BIND = spread" p
   { cat pinned.out; fail "pinned: no placement warning"; }
 echo "ok: placement warning"
 run 2 1 --validate valid.xml | grep -q "is valid" || fail "--validate of a valid input"
+# Every shipped input validates (the paper-resolution runs are not run by the tests; a change of
+# the input reference must not leave one of them refused).
+shipped=0
+for f in "$SRC"/inputs/*.xml; do
+  run 1 1 --validate "$f" >shipped.out 2>&1 && grep -qF "$f is valid" shipped.out ||
+    { cat shipped.out; fail "shipped input $f does not validate"; }
+  shipped=$((shipped + 1))
+done
+((shipped >= 10)) || fail "only $shipped shipped inputs found in $SRC/inputs"
+echo "ok: the $shipped shipped inputs validate"
 # stdout of --print-defaults, --help and --validate holds their output alone, whatever the OpenMP
 # environment (Kokkos warned about OMP_PROC_BIND into stdout, making defaults.xml invalid XML).
 env -u OMP_PROC_BIND -u OMP_PLACES "$MUPM" --print-defaults >defaults.xml
