@@ -159,6 +159,15 @@ void bc_template(ParameterList& c) {
         "outside its face only (corners, body points) hold g either way (README, 'Boundary "
         "layers').",
         one_of({"Default", "Constant", "Mirrored"}));
+  c.set("Traction Distribution", std::string("Outer Row"),
+        "How a Traction is spread over the points. Outer Row: traction / dx on the region's "
+        "points (the region: the outermost real row of the face; the paper's method). "
+        "Consistent: the region is a box holding the outermost real row of exactly one face "
+        "(and not the next row); the traction loads the strip of points within 2 delta + dx of "
+        "that face (and its boundary layer) inside the box's other coordinates, with the force "
+        "and couple densities that balance the uniform stress carrying the traction (so a "
+        "uniform field is in equilibrium up to the face; README, 'Boundary layers').",
+        one_of({"Outer Row", "Consistent"}));
 }
 
 // The user-named sublists: validated against their template one by one, not by Teuchos'
@@ -807,6 +816,12 @@ void check_dimension_arrays(ParameterList& input) {
       throw InputError("Error, " + path_of(c, "Component") + " = " + comp + ": a " +
                        std::to_string(dim) + "D body has components x" +
                        (dim == 3 ? ", y and z." : " and y."));
+    if (type != BoundaryCondition::Traction &&
+        c.get<std::string>("Traction Distribution") != "Outer Row")
+      throw InputError("Error, " + path_of(c, "Traction Distribution") + " = " +
+                       c.get<std::string>("Traction Distribution") +
+                       ": only a Traction is distributed; a " + c.get<std::string>("Type") +
+                       " condition takes Outer Row (the default).");
     // Fluid Flux sets its layer one way only (the flux's continuation of the body's pressure).
     if (type == BoundaryCondition::FluidFlux &&
         c.get<std::string>("Boundary Layer Values") != "Default")
@@ -1345,6 +1360,8 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterLis
     bc.mirrored = bc.kind == BoundaryCondition::FluidFlux ||
                   (bc.kind == BoundaryCondition::PorePressure && values == "Mirrored") ||
                   (bc.kinematic() && c.get<std::string>("Boundary Layer Values") == "Mirrored");
+    bc.consistent = bc.kind == BoundaryCondition::Traction &&
+                    c.get<std::string>("Traction Distribution") == "Consistent";
     out.push_back(bc);
   }
   return out;

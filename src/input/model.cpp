@@ -222,6 +222,47 @@ void check_fluid_flux(const GridSpec<Dim>& g, const std::vector<BoundaryConditio
                        "flux enters through that face.");
 }
 
+// Traction Distribution = Consistent (kernels/boundary_conditions.hpp, consistent_traction_load):
+// the region must be one box that holds the outermost real row of exactly one face of the body
+// and not the row next to it; sets the condition's face.
+template <int Dim>
+void check_consistent_traction(const GridSpec<Dim>& g, std::vector<BoundaryCondition>& bcs,
+                               const std::string& root) {
+  for (auto& bc : bcs) {
+    if (!bc.consistent)
+      continue;
+    const std::string path = root + "->Boundary Conditions->" + bc.name + "->";
+    const std::uint32_t mask = bc.region_mask;
+    if (mask == 0 || (mask & (mask - 1)) != 0)
+      throw InputError("Error, " + path +
+                       "Region: Traction Distribution = Consistent needs a region of "
+                       "Discretization->Regions (a box on one face), not All or a layer.");
+    int r = 0;
+    while (!(mask & (1u << r)))
+      ++r;
+    const Box& b = g.regions[std::size_t(r)];
+    int faces = 0;
+    for (int a = 0; a < Dim; ++a)
+      for (int side = 0; side < 2; ++side) {
+        const double n = side ? 1.0 : -1.0;
+        const double plane = g.origin[a] + (side ? g.counts[a] * g.dx : 0.0);
+        const double outer = plane - n * 0.5 * g.dx, next = plane - n * 1.5 * g.dx;
+        const bool holds_outer = b.lo[a] <= outer && outer <= b.hi[a];
+        const bool holds_next = b.lo[a] <= next && next <= b.hi[a];
+        if (holds_outer && !holds_next) {
+          bc.face = 2 * a + side;
+          ++faces;
+        }
+      }
+    if (faces != 1)
+      throw InputError(
+          "Error, " + path + "Region: Traction Distribution = Consistent needs a box that holds " +
+          "the outermost real row of exactly one face of the body (its coordinate across that " +
+          "face within half a spacing of the face) and not the next row; this one holds " +
+          (faces == 0 ? "none." : "the outer row of " + std::to_string(faces) + " faces."));
+  }
+}
+
 template <int Dim>
 Model<Dim> model_from_input(const ParameterList& input) {
   Model<Dim> m;
@@ -343,6 +384,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
   check_mirrored_kinematic(m.grid, m.boundary_conditions, input.name(), r.physics,
                            m.constitutive_model, m.fracture.criterion, !m.j_integral.half.empty());
   check_fluid_flux(m.grid, m.boundary_conditions, input.name());
+  check_consistent_traction(m.grid, m.boundary_conditions, input.name());
   m.initial_conditions = initial_conditions_from_input(input);
   return m;
 }

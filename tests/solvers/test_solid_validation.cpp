@@ -120,7 +120,10 @@ TEST(SolidValidation, CosseratLayerSimpleShear) {
 //   has the traction problem's solution, so the top clamp's reaction over the width must be
 //   tau; or
 // - the issue's test: theta = 0 held on the top (u free there) and the shear traction tau on the
-//   top row of real points (a body force tau / dx).
+//   top row of real points (a body force tau / dx), or, `consistent`, distributed as Traction
+//   Distribution = Consistent does (kernels/boundary_conditions.hpp, consistent_traction_load:
+//   the strip within 2 delta + dx of the top face, the slaved layer's free u included, balancing
+//   the uniform shear stress tau that the discrete operator with its fold makes of it).
 // `slaved`: Boundary Layer Values = Mirrored (kernels/boundary_conditions.hpp, slave_layer: the
 // layers carry no strain energy and follow their mirrors oddly, their forces folded back), else
 // Constant (the paper's: the layers hold g and keep their energy). Infinite in x by periodic
@@ -136,7 +139,8 @@ struct ClampedLayer {
   double theta_mid_error = 0, u_mid_error = 0;  // at the row next below h / 2
   double stiffness_ratio = 0;  // G_eff / mu = tau h / (mu u(h)): driven from the reaction
 };
-ClampedLayer cosserat_layer_between_layers(bool slaved, bool driven, int per_h) {
+ClampedLayer cosserat_layer_between_layers(bool slaved, bool driven, int per_h,
+                                           bool consistent = false) {
   const CosseratShear cs;
   const double mu = cs.mu, mu_c = cs.mu_c, l = cs.l, h = cs.h, tau = cs.tau, lambda = cs.lambda;
   auto theta_exact = [&](double y) { return cs.theta(y); };
@@ -247,13 +251,45 @@ ClampedLayer cosserat_layer_between_layers(bool slaved, bool driven, int per_h) 
         });
     fold_layer_forces(body.disc, slots, f, mo, fold);
   };
-  Vectors load("load", p.n_owned, 2), none;
+  Vectors load("load", p.n_owned, 2), none, couple("couple", p.n_owned, 1);
   if (!driven) {
     auto b = Kokkos::create_mirror_view(load);
     Kokkos::deep_copy(b, 0.0);
-    for (std::size_t i = 0; i < p.n_owned; ++i)
-      if (!outside(&xh(i, 0)) && xh(i, 1) < h && xh(i, 1) > h - dx)
-        b(i, 0) = tau / dx;
+    if (!consistent) {
+      for (std::size_t i = 0; i < p.n_owned; ++i)
+        if (!outside(&xh(i, 0)) && xh(i, 1) < h && xh(i, 1) > h - dx)
+          b(i, 0) = tau / dx;
+    } else {
+      SolidState<2> tmp;
+      tmp.allocate(p.size(), p.n_owned);
+      uniform_stress_forces(body.disc, body.prm, unit_traction_stress(2, 3, 0), tmp);
+      auto f = tmp.force, mo = tmp.moment;
+      Kokkos::parallel_for(
+          range(0, 1), KOKKOS_LAMBDA(const std::size_t) {
+            for (std::size_t k = 0; k < img.extent(0); ++k) {
+              const int i = img(k), m = src(k);
+              f(m, 0) += f(i, 0);
+              f(i, 0) = 0;
+              mo(m, 0) += mo(i, 0);
+              mo(i, 0) = 0;
+            }
+          });
+      fold_layer_forces(body.disc, slots, f, mo, fold);
+      Vectors unit("unit_load", p.n_owned, 3);
+      consistent_traction_load(p, 3, 0, 2 * g.horizon + dx, {0, -1, 0}, {W, 1, 0}, h, f, mo, unit);
+      auto uh = Kokkos::create_mirror_view_and_copy(HostSpace(), unit);
+      auto c = Kokkos::create_mirror_view(couple);
+      auto vol = Kokkos::create_mirror_view_and_copy(HostSpace(), p.volume);
+      double total = 0;
+      for (std::size_t i = 0; i < p.n_owned; ++i) {
+        b(i, 0) = tau * uh(i, 0);
+        c(i, 0) = tau * uh(i, 2);
+        total += b(i, 0) * vol(i);
+      }
+      // The discrete divergence theorem: the strip carries the traction times the face's area.
+      EXPECT_NEAR(total, tau * W * g.thickness, 1e-12 * tau * W * g.thickness);
+      Kokkos::deep_copy(couple, c);
+    }
     Kokkos::deep_copy(load, b);
   }
   const double c_s = std::sqrt(mu / 2000.0), damping = 2 * kPi * c_s / (2 * h);
@@ -265,7 +301,7 @@ ClampedLayer cosserat_layer_between_layers(bool slaved, bool driven, int per_h) 
     advance_positions(p, dt);
     set_layers();
     forces();
-    advance_velocities(p, body.st.force, body.st.moment, body.rho, body.inertia, load, none,
+    advance_velocities(p, body.st.force, body.st.moment, body.rho, body.inertia, load, couple,
                        {0, 0, 0}, damping, dt);
   }
   auto u = Kokkos::create_mirror_view_and_copy(HostSpace(), p.u);
@@ -303,11 +339,12 @@ ClampedLayer cosserat_layer_between_layers(bool slaved, bool driven, int per_h) 
 }
 
 // The issue's targets at h = 80 dx with plain (slaved) layers: u(h) within 1 % and theta(h/2)
-// within 2 % (the traction-loaded layer), the size effect G_eff / mu = 1.0426 within 0.5 %
-// (from the reaction of the clamp-driven layer: with the traction on the top row, u(h) carries
-// the loaded face's own excess, measured 0.55 % in G_eff and reported, README "Boundary
-// layers"). Constant layers (the paper's method) are measured for the record and must be the
-// worse. The closed form's stiffness ratio is computed here, not copied.
+// within 2 % (the traction-loaded layer), the size effect G_eff / mu = 1.0426 within 0.5 %, from
+// the reaction of the clamp-driven layer and from u(h) of the traction-loaded one. The traction
+// on the top row (traction / dx, the paper's) leaves the loaded face acting ~0.55 dx above h
+// (G_eff -0.55 %, measured and reported, not asserted); the consistent distribution is asserted.
+// Constant layers (the paper's method) are measured for the record and must be the worse. The
+// closed form's stiffness ratio is computed here, not copied.
 TEST(SolidValidation, CosseratLayerBetweenSlavedClamps) {
   int ranks = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
@@ -317,19 +354,20 @@ TEST(SolidValidation, CosseratLayerBetweenSlavedClamps) {
   const double stiffness = cs.tau * cs.h / (cs.mu * cs.u(cs.h));
   EXPECT_NEAR(stiffness, 1.0426, 1e-4);  // VALIDATION.md's reference number
   for (const bool driven : {true, false}) {
-    ClampedLayer r[2];
-    for (const bool slaved : {false, true}) {
-      r[slaved] = cosserat_layer_between_layers(slaved, driven, 80);
+    ClampedLayer r[3];  // constant, slaved, slaved with the consistent traction (traction only)
+    for (int k = 0; k < (driven ? 2 : 3); ++k) {
+      r[k] = cosserat_layer_between_layers(k > 0, driven, 80, k == 2);
       const std::string tag =
-          std::string(driven ? "driven" : "traction") + (slaved ? "_slaved" : "_constant");
+          std::string(driven ? "driven" : "traction") + (k == 0   ? "_constant"
+                                                         : k == 1 ? "_slaved"
+                                                                  : "_slaved_consistent");
       std::printf(
           "%s: tau %+.3f %%, u(h) %+.3f %%, top row %+.3f %%, u(h/2) %+.3f %%, "
           "theta(h/2) %+.3f %%, G_eff/mu %.5f (closed form %.5f)\n",
-          tag.c_str(), 100 * r[slaved].tau_error, 100 * r[slaved].u_top_error,
-          100 * r[slaved].u_row_error, 100 * r[slaved].u_mid_error, 100 * r[slaved].theta_mid_error,
-          r[slaved].stiffness_ratio, stiffness);
-      RecordProperty(tag + "_stiffness_ratio", std::to_string(r[slaved].stiffness_ratio));
-      RecordProperty(tag + "_theta_mid_error", std::to_string(r[slaved].theta_mid_error));
+          tag.c_str(), 100 * r[k].tau_error, 100 * r[k].u_top_error, 100 * r[k].u_row_error,
+          100 * r[k].u_mid_error, 100 * r[k].theta_mid_error, r[k].stiffness_ratio, stiffness);
+      RecordProperty(tag + "_stiffness_ratio", std::to_string(r[k].stiffness_ratio));
+      RecordProperty(tag + "_theta_mid_error", std::to_string(r[k].theta_mid_error));
     }
     const std::string tag = driven ? "driven" : "traction";
     EXPECT_LT(std::abs(r[1].theta_mid_error), 0.02) << tag;
@@ -340,6 +378,10 @@ TEST(SolidValidation, CosseratLayerBetweenSlavedClamps) {
     } else {
       EXPECT_LT(std::abs(r[1].u_top_error), 0.01);
       EXPECT_LT(std::abs(r[1].u_top_error), std::abs(r[0].u_top_error));
+      EXPECT_LT(std::abs(r[2].theta_mid_error), 0.02);
+      EXPECT_LT(std::abs(r[2].u_top_error), 0.01);
+      EXPECT_LT(std::abs(r[2].stiffness_ratio / stiffness - 1), 0.005);
+      EXPECT_LT(std::abs(r[2].u_top_error), std::abs(r[1].u_top_error));
     }
   }
 }

@@ -96,6 +96,12 @@ struct BoundaryCondition {
   // Column of Discretization::mirror it reflects with: the axis of the face its region lies
   // outside of (face_column in mesh/grid.hpp), or Dim (its points outside one face only).
   int mirror_column = 0;
+  // Traction Distribution = Consistent (consistent_traction_load): the face the traction loads
+  // (2 axis + side, side 1 the high face; set by the input checks), and the load of a unit Value
+  // ([n_owned][Dim + R]: force density, then couple density; filled by the solid solver).
+  bool consistent = false;
+  int face = -1;
+  Vectors unit_load;
   bool kinematic() const {
     return kind == Displacement || kind == Velocity || kind == MicroRotation;
   }
@@ -368,9 +374,59 @@ void add_folded(const Points<Dim>& pts, const Vectors& buf, const Vectors& force
       });
 }
 
+// The stress of a unit traction in direction c on the face 2 axis + side (kernels/solid.hpp,
+// uniform_stress_pass1): the symmetric sigma with sigma n = e_c, n = +-e_axis the outward normal,
+// and no other component (sigma_ca = sigma_ac = n_axis). Only sigma n enters the force on a flat
+// face (f_i = sigma g_i with g_i along n); the complementary sigma_ac enters the moment there.
+inline Kokkos::Array<double, 9> unit_traction_stress(int dim, int face, int c) {
+  Kokkos::Array<double, 9> s{};
+  const int a = face / 2;
+  const double n = face % 2 ? 1.0 : -1.0;
+  s[c * dim + a] = s[a * dim + c] = n;
+  return s;
+}
+
+// Traction Distribution = Consistent (the boundary-layer issue, item 5): the load of a unit
+// traction in direction c on a face, as the body-force and couple densities that balance the
+// forces the discrete operator makes of the uniform stress that traction carries
+// (`force`, `moment`: uniform_stress_forces of unit_traction_stress, folded like the run's forces
+// where layers are slaved). On the points of the strip along the face within `depth` of it
+// (inside, and the boundary layer beyond it) whose other coordinates lie in [lo, hi]:
+//   b_i = -f_i[sigma] . e_c e_c,   c_i = -l_i[sigma];
+// zero elsewhere. A uniform stress field that carries the traction is then in equilibrium to
+// round-off up to the loaded face (a patch test), where a traction / dx on the outer row leaves
+// it out of balance within 2 delta of the face (the face then acts ~0.2 dx off in a bar under
+// tension, and a traction-loaded Cosserat layer with a slaved top layer 0.55 dx: README
+// "Boundary layers"). Sum_i b_i V_i is the traction times the face's area to round-off on a
+// flat face (the discrete divergence theorem: f = 0 in the interior and sum_i f_i V_i = 0).
+// Only the component c of f is kept: at the face's edges, where the strip meets a free face, the
+// uniform shear stress would also need the complementary traction on that free face.
+template <int Dim>
+void consistent_traction_load(const Points<Dim>& pts, int face, int c, double depth,
+                              const Kokkos::Array<double, 3>& lo,
+                              const Kokkos::Array<double, 3>& hi, double plane,
+                              const Vectors& force, const Vectors& moment, const Vectors& out) {
+  constexpr int R = kRotDim<Dim>;
+  const int axis = face / 2;
+  const double n = face % 2 ? 1.0 : -1.0;
+  auto x = pts.x;
+  Kokkos::parallel_for(
+      "mupm::BC::consistent_traction", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+        bool in = n * (plane - x(i, axis)) < depth;  // inside within depth, or beyond the face
+        for (int d = 0; d < Dim; ++d)
+          if (d != axis && (x(i, d) < lo[d] || x(i, d) > hi[d]))
+            in = false;
+        for (int k = 0; k < Dim; ++k)
+          out(i, k) = in && k == c ? -force(i, k) : 0.0;
+        for (int r = 0; r < R; ++r)
+          out(i, Dim + r) = in ? -moment(i, r) : 0.0;
+      });
+}
+
 // Body-force density [N/m^3] at time t: body forces on their regions, and tractions [Pa] spread
 // over the points of their region as traction / dx (the region should be the outermost real
-// row of points of the loaded face, one spacing thick).
+// row of points of the loaded face, one spacing thick), or, with Traction Distribution =
+// Consistent, as value g(t) times their unit_load (force and couple densities).
 // Body couples [N m/m^3] go to `couple` (component = rotation component).
 template <int Dim>
 void body_force_density(const std::vector<BoundaryCondition>& bcs, const Points<Dim>& pts,
@@ -380,6 +436,20 @@ void body_force_density(const std::vector<BoundaryCondition>& bcs, const Points<
   for (const auto& bc : bcs) {
     if (bc.kinematic() || bc.fluid())
       continue;
+    if (bc.unit_load.extent(0) > 0) {
+      constexpr int R = kRotDim<Dim>;
+      const double s = bc.value * bc.time(t);
+      auto load = bc.unit_load;
+      Kokkos::parallel_for(
+          "mupm::BC::consistent_traction_add", range(0, pts.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i) {
+            for (int k = 0; k < Dim; ++k)
+              body(i, k) += s * load(i, k);
+            for (int r = 0; r < R; ++r)
+              couple(i, r) += s * load(i, Dim + r);
+          });
+      continue;
+    }
     const Vectors target = bc.kind == BoundaryCondition::BodyCouple ? couple : body;
     const std::uint32_t mask = bc.region_mask;
     const int c = bc.component;

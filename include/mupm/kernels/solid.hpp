@@ -437,6 +437,45 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
       });
 }
 
+// Pass 1 of a uniform total stress sigma ([Dim*Dim], row a = force direction, as P1) with no
+// stabilization, for the consistent surface load of a traction (include/mupm/kernels/
+// boundary_conditions.hpp, consistent_traction_load): P1 = sigma K^-1 on the points that carry
+// energy (0 on slaved layer points and where K is singular), P2 = eps = kappa = 0, w0 = 0. Pass 2
+// then gives the force and moment densities the discrete operator makes of that stress,
+//   f_i = sigma sum_j (K_i^-1 + K_j^-1) xi V_j,   l_i = 1/2 sum_j xi x (T_ij - T_ji) V_j
+// (eqs 105-112 with T = sigma K^-1 xi): zero where families are whole and K is the bulk's, the
+// surface's share of the divergence of sigma within 2 delta of a face. Sign: f_i V_i summed over
+// a strip along a face is -sigma n times the face's area (n outward).
+template <int Dim>
+void uniform_stress_pass1(const Points<Dim>& pts, const ShapeTensors<Dim>& shape,
+                          const Kokkos::Array<double, 9>& sigma, SolidState<Dim>& st) {
+  constexpr int R = kRotDim<Dim>;
+  auto fixed = pts.fixed;
+  auto Kinv_v = shape.Kinv;
+  auto sing = shape.singular;
+  auto eps_v = st.eps, kap_v = st.kappa, P1 = st.P1, P2 = st.P2, w0_v = st.w0;
+  auto degen = st.degenerate;
+  Kokkos::parallel_for(
+      "mupm::Solid::uniform_stress_pass1", range(0, pts.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i) {
+        const bool zero = (fixed(i) & kFixedNoEnergy) || sing(i);
+        double Kinv[Dim * Dim], s[Dim * Dim], p1[Dim * Dim];
+        for (int k = 0; k < Dim * Dim; ++k) {
+          Kinv[k] = Kinv_v(i, k);
+          s[k] = sigma[k];
+        }
+        mat_mul<Dim, Dim>(s, Kinv, p1);
+        for (int k = 0; k < Dim * Dim; ++k) {
+          eps_v(i, k) = 0;
+          P1(i, k) = zero ? 0.0 : p1[k];
+        }
+        for (int k = 0; k < R * Dim; ++k)
+          kap_v(i, k) = P2(i, k) = 0;
+        w0_v(i) = 0;
+        degen(i) = 0;
+      });
+}
+
 }  // namespace mupm
 
 #endif

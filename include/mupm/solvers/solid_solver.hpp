@@ -57,6 +57,17 @@ void fold_layer_forces(Discretization<Dim>& disc, const FaceSlots& slots, const 
   Kokkos::fence();
 }
 
+// The force and moment densities the discrete operator makes of a uniform total stress sigma
+// (kernels/solid.hpp, uniform_stress_pass1), into st.force and st.moment (st allocated for the
+// discretization, st.work Off).
+template <int Dim>
+void uniform_stress_forces(Discretization<Dim>& disc, const SolidParams& prm,
+                           const Kokkos::Array<double, 9>& sigma, SolidState<Dim>& st) {
+  uniform_stress_pass1(disc.points, disc.shape, sigma, st);
+  disc.dist.refresh(st.pass2_ghosts());
+  solid_pass2(disc.points, disc.bonds, prm, st);
+}
+
 // What the solid solver takes besides the law's parameters (the same for every law).
 struct SolidSettings {
   double rho_s = 2000, rho_w = 1000;
@@ -144,6 +155,7 @@ class SolidSolver : public Mechanics {
       st_.increment = du_;
       st_.max_energy = Scalars("mupm::max_bond_energy", p.n_owned);
     }
+    build_consistent_tractions();
   }
   // Bonds break during the run (by either criterion); the bond energies are accumulated for the
   // energy criterion only.
@@ -664,6 +676,39 @@ class SolidSolver : public Mechanics {
   }
   // The slaved layer points' forces and moments onto their mirrors (pack_layer_forces), across
   // ranks. The layer points keep theirs: the reactions and the external work are made of them.
+  // Traction Distribution = Consistent (kernels/boundary_conditions.hpp,
+  // consistent_traction_load): each such traction's load of a unit Value, from the families at
+  // construction (bonds broken later leave it as it was), on the strip within 2 delta + dx of its
+  // face whose other coordinates lie in the condition's region box.
+  void build_consistent_tractions() {
+    auto& p = disc_.points;
+    const auto& g = disc_.grid;
+    SolidState<Dim> tmp;
+    for (auto& bc : bcs_) {
+      if (!bc.consistent)
+        continue;
+      if (tmp.force.extent(0) == 0)
+        tmp.allocate(p.size(), p.n_owned);
+      uniform_stress_forces(disc_, prm_, unit_traction_stress(Dim, bc.face, bc.component), tmp);
+      if (slaved_)
+        fold_layer_forces(disc_, slots_, tmp.force, tmp.moment, fold_);
+      int r = 0;
+      while (!(bc.region_mask & (1u << r)))
+        ++r;
+      const Box& box = g.regions[std::size_t(r)];
+      const int axis = bc.face / 2;
+      Kokkos::Array<double, 3> lo{}, hi{};
+      for (int d = 0; d < Dim; ++d) {
+        lo[d] = box.lo[d];
+        hi[d] = box.hi[d];
+      }
+      const double plane = g.origin[axis] + (bc.face % 2 ? g.counts[axis] * g.dx : 0.0);
+      bc.unit_load = Vectors("mupm::traction_load", p.n_owned, Dim + R);
+      consistent_traction_load(p, bc.face, bc.component, 2 * g.horizon + g.dx, lo, hi, plane,
+                               tmp.force, tmp.moment, bc.unit_load);
+    }
+  }
+
   void fold_layers() {
     if (!slaved_)
       return;
