@@ -199,6 +199,30 @@ expect flux_layer_values 2 'mupm->Boundary Conditions->hold->Boundary Layer Valu
 sed -e 's|value="Layer -x"|value="All"|' -e '/name="Boundary Layer Values" type="string" value="Mirrored"/d' \
   flux_layer_values.xml >flux_region.xml
 expect flux_region 2 'mupm->Boundary Conditions->hold->Region' 'outside exactly one face'
+# Traction Distribution = Consistent: Traction only, on a box holding one face's outer row; a
+# valid one runs (20 x 10 body of spacing 0.01: the +x face's outer row at x = 0.195).
+base '<ParameterList name="Regions"><ParameterList name="end">
+      <Parameter name="Min" type="Array(double)" value="{0.19, -1}"/>
+      <Parameter name="Max" type="Array(double)" value="{0.2, 1}"/></ParameterList></ParameterList>' '' |
+  sed '$d' >consistent_traction.xml
+cat >>consistent_traction.xml <<'XML'
+  <ParameterList name="Boundary Conditions"><ParameterList name="pull">
+    <Parameter name="Type" type="string" value="Traction"/>
+    <Parameter name="Region" type="string" value="end"/>
+    <Parameter name="Value" type="double" value="1e5"/>
+    <Parameter name="Traction Distribution" type="string" value="Consistent"/>
+  </ParameterList></ParameterList>
+</ParameterList>
+XML
+run 2 1 consistent_traction.xml >consistent_traction.out 2>&1 ||
+  { cat consistent_traction.out; fail "consistent_traction.xml did not run"; }
+echo "ok: consistent_traction runs"
+sed 's|value="Traction"|value="Body Force"|' consistent_traction.xml >consistent_body_force.xml
+expect consistent_body_force 2 'mupm->Boundary Conditions->pull->Traction Distribution = Consistent' 'only a Traction is distributed'
+sed 's|value="{0.19, -1}"|value="{0.17, -1}"|' consistent_traction.xml >consistent_two_rows.xml
+expect consistent_two_rows 2 'mupm->Boundary Conditions->pull->Region' 'outermost real row of exactly one face' 'holds none'
+sed 's|value="end"|value="All"|' consistent_traction.xml >consistent_all.xml
+expect consistent_all 2 'mupm->Boundary Conditions->pull->Region' 'not All or a layer'
 base '' '' | sed 's|value="out"|value="done"|' >done.xml
 run 2 1 done.xml >done.out 2>&1 || { cat done.out; fail "done.xml did not run"; }
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |
