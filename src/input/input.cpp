@@ -143,6 +143,8 @@ void bc_template(ParameterList& c) {
         "Values on boundary-layer points. Pore Pressure: Constant (the prescribed value g, the "
         "paper's method) or Mirrored (2 g - p of the body point mirrored about the face, so that "
         "p passes through g at the face); Default: Discretization->Boundary Layer Values. "
+        "Fracture Pressure: the same, with 2 g - p_f(m) of the step's start on its fracture "
+        "points whose mirror m is a fracture point that no condition holds (g on the others). "
         "Displacement, Velocity and Micro-Rotation (Physics = Micropolar Solid): Mirrored (this "
         "parameter only; the region must lie outside one face). A mirrored Displacement of the "
         "face's "
@@ -221,12 +223,15 @@ RCP<ParameterList> valid_parameters() {
           "Each layer is also a region named 'Layer -y' etc.",
           rcp(new Teuchos::ArrayStringValidator(one_of(kFaces))));
     d.set("Boundary Layer Values", std::string("Constant"),
-          "How Pore Pressure conditions set their boundary-layer points, unless a condition's "
+          "How Pore Pressure and Fracture Pressure conditions set their boundary-layer points, "
+          "unless a condition's "
           "own Boundary Layer Values says otherwise. Constant: the prescribed value g (the "
           "paper's method; the face then drains as if it sat about 0.7 delta farther out). "
           "Mirrored: a layer point at distance d outside the face takes 2 g - p(m), p(m) the "
           "pressure of the point m at distance d inside, every fluid substep (the face: the one "
-          "the condition's region lies outside of). Kinematic conditions stay Constant unless "
+          "the condition's region lies outside of; a Fracture Pressure's points take 2 g - "
+          "p_f(m) of the step's start where m is a fracture point no condition holds, else g). "
+          "Kinematic conditions stay Constant unless "
           "their own Boundary Layer Values says Mirrored. See "
           "README, 'Boundary layers'.",
           one_of({"Constant", "Mirrored"}));
@@ -834,11 +839,12 @@ void check_dimension_arrays(ParameterList& input) {
     // without bound at H = 40 dx). Kinematic conditions mirror by the reflection R (a symmetry
     // plane) or by slaving energy-free layers (input/model.cpp, kernels/boundary_conditions.hpp).
     if (c.get<std::string>("Boundary Layer Values") == "Mirrored" &&
-        type != BoundaryCondition::PorePressure && type != BoundaryCondition::Displacement &&
-        type != BoundaryCondition::Velocity && type != BoundaryCondition::MicroRotation)
+        type != BoundaryCondition::PorePressure && type != BoundaryCondition::FracturePressure &&
+        type != BoundaryCondition::Displacement && type != BoundaryCondition::Velocity &&
+        type != BoundaryCondition::MicroRotation)
       throw InputError("Error, " + path_of(c, "Boundary Layer Values") +
-                       " = Mirrored: only Pore Pressure, Displacement, Velocity and Micro-Rotation "
-                       "conditions mirror their boundary-layer values; " +
+                       " = Mirrored: only Pore Pressure, Fracture Pressure, Displacement, Velocity "
+                       "and Micro-Rotation conditions mirror their boundary-layer values; " +
                        c.get<std::string>("Type") +
                        " conditions hold the prescribed value (write Constant or Default).");
     const auto tf = time_function_options()(c.get<std::string>("Time Function"));
@@ -1358,7 +1364,9 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterLis
     // The Discretization's default reaches Pore Pressure only; a Displacement or Micro-Rotation
     // condition mirrors when it says so itself (input/model.cpp, check_mirrored_kinematic).
     bc.mirrored = bc.kind == BoundaryCondition::FluidFlux ||
-                  (bc.kind == BoundaryCondition::PorePressure && values == "Mirrored") ||
+                  ((bc.kind == BoundaryCondition::PorePressure ||
+                    bc.kind == BoundaryCondition::FracturePressure) &&
+                   values == "Mirrored") ||
                   (bc.kinematic() && c.get<std::string>("Boundary Layer Values") == "Mirrored");
     bc.consistent = bc.kind == BoundaryCondition::Traction &&
                     c.get<std::string>("Traction Distribution") == "Consistent";

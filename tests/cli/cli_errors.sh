@@ -173,7 +173,7 @@ cat >>mirrored_kinematic.xml <<'XML'
   </ParameterList></ParameterList>
 </ParameterList>
 XML
-expect mirrored_kinematic 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'only Pore Pressure, Displacement, Velocity and Micro-Rotation'
+expect mirrored_kinematic 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored' 'only Pore Pressure, Fracture Pressure, Displacement, Velocity'
 # A mirrored tangential Displacement slaves its layer (energy-free points), so no condition may
 # hold constant values on the same points.
 sed -e 's|value="Traction"|value="Displacement"|' \

@@ -6,7 +6,8 @@
 # 1 rank x 2 threads (fields and checkpoints compared byte for byte; for the crack, the broken
 # bonds too); the crack also by the J criterion (J and the broken bonds the same bits on 1 and 2
 # ranks), in a saturated, hydro-mechanical plate, and with water in the crack (fracture flow, both
-# crack-water force models), whose water balance is checked too; and a Drucker-Prager soil
+# crack-water force models, and a mirrored Fracture Pressure on a layer the crack runs into), whose
+# water balance is checked too; and a Drucker-Prager soil
 # restarted as its shear bands soften.
 source "$(dirname "$0")/common.sh"
 # make_input XML FOLDER STEPS RESTART [SED_EXPR]: the input (a path in the source tree) with
@@ -107,6 +108,10 @@ check fracture-hm tests/cli/fracture_small.xml 440 16 's|value="Micropolar Solid
 # the injection is strong enough for the crack to grow before the restart.
 flow_edit='s|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|; s|<Parameter name="Bond Breakage"|<Parameter name="Fracture Flow" type="bool" value="true"/><Parameter name="Minimum Aperture" type="double" value="1e-4"/><Parameter name="Bond Breakage"|; s|<ParameterList name="Pre-Cracks">|<ParameterList name="Regions"><ParameterList name="mouth"><Parameter name="Min" type="Array(double)" value="{0, 0.045}"/><Parameter name="Max" type="Array(double)" value="{0.005, 0.055}"/></ParameterList></ParameterList><ParameterList name="Pre-Cracks">|; s|<ParameterList name="Boundary Conditions">|<ParameterList name="Boundary Conditions"><ParameterList name="mouth"><Parameter name="Type" type="string" value="Fracture Source"/><Parameter name="Region" type="string" value="mouth"/><Parameter name="Value" type="double" value="1e-2"/></ParameterList>|'
 check fracture-flow tests/cli/fracture_small.xml 440 23 "$flow_edit"
+# The same with a drained boundary layer at the notch's face (-x) that the crack runs into, its
+# fracture points held by a mirrored Fracture Pressure (2 g - q, q relaxed from the step's start
+# and rebuilt from the checkpointed p_f: solvers/fracture_flow.hpp, assemble).
+check fracture-flow-mirrored tests/cli/fracture_small.xml 440 25 "s|value=\"\{-y, \+y\}\"|value=\"{-x, -y, +y}\"|; $flow_edit; s|<ParameterList name=\"Boundary Conditions\">|<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"drained\"><Parameter name=\"Type\" type=\"string\" value=\"Pore Pressure\"/><Parameter name=\"Region\" type=\"string\" value=\"Layer -x\"/></ParameterList><ParameterList name=\"mouth pressure\"><Parameter name=\"Type\" type=\"string\" value=\"Fracture Pressure\"/><Parameter name=\"Region\" type=\"string\" value=\"Layer -x\"/><Parameter name=\"Value\" type=\"double\" value=\"1e6\"/><Parameter name=\"Boundary Layer Values\" type=\"string\" value=\"Mirrored\"/></ParameterList>|"
 # Drucker-Prager plasticity (Example 3 at 16 x 32, dt = 1.75e-5 s): restarted at step 3700
 # (t = 0.065 s), as the bands soften, with the plastic state, the step's start state and the
 # second-order work's window in the checkpoint.
@@ -124,6 +129,10 @@ assert last > first and float(rows[-1]["fluid_inflow_mouth"]) > 0, (first, last)
 assert worst < 1e-12, worst
 print(f"restart fracture-flow: water conserved to {worst:.1e} of the body's while the network "
       f"grew from {first:.0f} to {last:.0f} points")
+rows = list(csv.DictReader(open("fracture-flow-mirrored-straight/time_series.csv")))
+worst = max(abs(float(r["fluid_mass_error"])) / float(r["fluid_mass"]) for r in rows)
+assert worst < 1e-12 and float(rows[-1]["fluid_inflow_mouth pressure"]) != 0, worst
+print(f"restart fracture-flow-mirrored: water conserved to {worst:.1e} of the body's")
 PY
 # And with the paper's eq 17 for the crack water's force.
 check fracture-eq17 tests/cli/fracture_small.xml 440 22 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|; s|<Parameter name="Bond Breakage"|<Parameter name="Fracture Flow" type="bool" value="true"/><Parameter name="Crack Water Force" type="string" value="Eq 17"/><Parameter name="Bond Breakage"|; s|<ParameterList name="Pre-Cracks">|<ParameterList name="Regions"><ParameterList name="mouth"><Parameter name="Min" type="Array(double)" value="{0, 0.045}"/><Parameter name="Max" type="Array(double)" value="{0.005, 0.055}"/></ParameterList></ParameterList><ParameterList name="Pre-Cracks">|; s|<ParameterList name="Boundary Conditions">|<ParameterList name="Boundary Conditions"><ParameterList name="mouth"><Parameter name="Type" type="string" value="Fracture Source"/><Parameter name="Region" type="string" value="mouth"/><Parameter name="Value" type="double" value="5e-5"/></ParameterList>|'
