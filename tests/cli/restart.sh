@@ -96,6 +96,11 @@ cond() {  # cond NAME LAYER TYPE COMPONENT [VALUE]
 }
 clamps="$(cond "top x" "Layer +y" Velocity x 0.05)$(cond "top rotation" "Layer +y" Micro-Rotation z)$(cond "bottom x" "Layer -y" Displacement x)$(cond "bottom rotation" "Layer -y" Micro-Rotation z)"
 check solid-clamped inputs/quickstart.xml 40 9 "s|(<Parameter name=\"Component\" type=\"string\" value=\"y\"/>)|\\1<Parameter name=\"Boundary Layer Values\" type=\"string\" value=\"Mirrored\"/>|; s|(<ParameterList name=\"Boundary Conditions\">)|\\1$clamps|"
+# The quick start with a shear traction on its free +x face, Traction Distribution = Consistent
+# (its load from the operator's own passes at start, kernels/boundary_conditions.hpp): the same
+# bits on 1 rank and on 2 ranks followed by 1 rank x 2 threads.
+shear='<ParameterList name="shear"><Parameter name="Type" type="string" value="Traction"/><Parameter name="Region" type="string" value="right face"/><Parameter name="Component" type="string" value="y"/><Parameter name="Value" type="double" value="1e6"/><Parameter name="Traction Distribution" type="string" value="Consistent"/></ParameterList>'
+check solid-traction inputs/quickstart.xml 40 8 "s|(<Parameter name=\"Boundary Layers\" type=\"Array\\(string\\)\" value=\"\\{-y, \\+y\\}\"/>)|\\1<ParameterList name=\"Regions\"><ParameterList name=\"right face\"><Parameter name=\"Min\" type=\"Array(double)\" value=\"{0.2475, -1}\"/><Parameter name=\"Max\" type=\"Array(double)\" value=\"{0.25, 1}\"/></ParameterList></ParameterList>|; s|(<ParameterList name=\"Boundary Conditions\">)|\\1$shear|"
 check fracture tests/cli/fracture_small.xml 440 11
 # The J criterion (Algorithm 3): the crack advances by increments from step ~200.
 check fracture-j tests/cli/fracture_small.xml 440 13 's|value="Energy"/>|value="J-Integral"/>|; s|  <ParameterList name="Boundary Conditions">|  <ParameterList name="J-Integral"><Parameter name="Half Widths" type="Array(double)" value="{4, 5}"/></ParameterList>\n&|'
