@@ -233,13 +233,14 @@ void check_consistent_traction(const GridSpec<Dim>& g, std::vector<BoundaryCondi
       continue;
     const std::string path = root + "->Boundary Conditions->" + bc.name + "->";
     const std::uint32_t mask = bc.region_mask;
-    if (mask == 0 || (mask & (mask - 1)) != 0)
+    int r = 0;
+    while (mask != 0 && !(mask & (1u << r)))
+      ++r;
+    if (mask == 0 || (mask & (mask - 1)) != 0 || r >= int(g.regions.size()) ||
+        face_axis(g, mask) >= 0)
       throw InputError("Error, " + path +
                        "Region: Traction Distribution = Consistent needs a region of "
                        "Discretization->Regions (a box on one face), not All or a layer.");
-    int r = 0;
-    while (!(mask & (1u << r)))
-      ++r;
     const Box& b = g.regions[std::size_t(r)];
     int faces = 0;
     for (int a = 0; a < Dim; ++a)
@@ -254,6 +255,16 @@ void check_consistent_traction(const GridSpec<Dim>& g, std::vector<BoundaryCondi
           ++faces;
         }
       }
+    // The strip (2 delta + dx deep) must not reach the surface forces of the opposite face
+    // (within 2 delta of it), which it would load with the opposite sign.
+    const int a = bc.face / 2;
+    if (faces == 1 && g.counts[a] * g.dx < 4 * g.horizon + g.dx)
+      throw InputError("Error, " + path + "Traction Distribution = Consistent: the body is " +
+                       std::to_string(g.counts[a] * g.dx) +
+                       " m across the loaded face, less than "
+                       "4 delta + dx = " +
+                       std::to_string(4 * g.horizon + g.dx) +
+                       " m, so the loaded strip would reach the opposite face; use Outer Row.");
     if (faces != 1)
       throw InputError(
           "Error, " + path + "Region: Traction Distribution = Consistent needs a box that holds " +

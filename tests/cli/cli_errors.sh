@@ -223,6 +223,10 @@ sed 's|value="{0.19, -1}"|value="{0.17, -1}"|' consistent_traction.xml >consiste
 expect consistent_two_rows 2 'mupm->Boundary Conditions->pull->Region' 'outermost real row of exactly one face' 'holds none'
 sed 's|value="end"|value="All"|' consistent_traction.xml >consistent_all.xml
 expect consistent_all 2 'mupm->Boundary Conditions->pull->Region' 'not All or a layer'
+# The +y face of the 0.1 m high body: 4 delta + dx = 0.13 m, so the strip would reach -y.
+sed -e 's|value="{0.19, -1}"|value="{-1, 0.095}"|' -e 's|value="{0.2, 1}"|value="{1, 0.1}"|' \
+  consistent_traction.xml >consistent_thin.xml
+expect consistent_thin 2 'mupm->Boundary Conditions->pull->Traction Distribution = Consistent: the body is 0.1' '4 delta + dx'
 base '' '' | sed 's|value="out"|value="done"|' >done.xml
 run 2 1 done.xml >done.out 2>&1 || { cat done.out; fail "done.xml did not run"; }
 base '' '<Parameter name="Restart From" type="string" value="done/checkpoint.h5"/>' |

@@ -92,6 +92,41 @@ TEST(Neighbors, BruteForce2DWithCrackAndLayers) {
   check_against_brute_force(g, {FlatCrack{1, 0.05, {-0.001, 0, 0}, {0.062, 0, 0}}});
 }
 
+// Both copies of every bond agree on whether it crosses a pre-crack, also for the bonds through
+// a crack's tip on a lattice node (geometry.hpp, bond_crosses): the tip (-0.01, 0.05) at
+// dx = 2.5 mm, inside a boundary layer, where the two copies of one bond disagreed by round-off.
+TEST(Neighbors, CrackTipBondsAgreeBothWays) {
+  auto g = test::box<2>({16, 40}, 3.015, 0.0025);
+  g.layers = {{{6, 0}, {0, 0}}};
+  Crack c;
+  c.a[0] = -0.01;
+  c.a[1] = 0.05;
+  c.b[0] = 0.02;
+  c.b[1] = 0.05;
+  g.cracks = {c};
+  auto disc = discretize(test::world(), g);
+  const auto& pts = disc.points;
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), pts.gid);
+  auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.offsets);
+  auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.neighbor);
+  auto intact = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.intact);
+  std::map<std::pair<GlobalId, GlobalId>, int> state;  // owned ends only: every pair on 1 rank
+  for (std::size_t i = 0; i < pts.n_owned; ++i)
+    for (BondIndex b = off(i); b < off(i + 1); ++b)
+      state[{gid(i), gid(nb(b))}] = intact(b);
+  long long pairs = 0, broken = 0;
+  for (const auto& [key, ok] : state) {
+    const auto back = state.find({key.second, key.first});
+    if (back == state.end())
+      continue;  // the other end lives on another rank
+    ++pairs;
+    broken += ok ? 0 : 1;
+    EXPECT_EQ(ok, back->second) << key.first << " -> " << key.second;
+  }
+  EXPECT_GT(pairs, 0);
+  EXPECT_GT(broken, 0);  // the crack broke bonds
+}
+
 TEST(Neighbors, BruteForce3DWithCrack) {
   auto g = test::box<3>({7, 6, 8}, 3.015);
   g.layers[2] = {3, 0};

@@ -77,6 +77,54 @@ double column_u(const BarResult& r, double x, double dx) {
   return sum / std::max(n, 1);
 }
 
+// A bar under a consistent traction whose loaded face has a slaved layer beyond it (theta = 0
+// Mirrored on it, u free there: the traction-loaded face of the Cosserat layer in
+// test_solid_validation.cpp, through the solver): the uniform tension (theta = 0) continues into
+// the layer, so the loaded column stays on the interior's line. Built before the layer's points
+// were marked energy-free, the load would balance stresses those points do not carry.
+TEST(SolidSolver, ConsistentTractionWithSlavedLayer) {
+  const double dx = 2.5e-3, t = 1e5;
+  auto g = test::box<2>({40, 8}, 3.015, dx);
+  g.layers[0] = {g.horizon_cells(), 2 * g.horizon_cells()};
+  g.mirrored_layers = true;
+  const double L = 40 * dx, H = 8 * dx;
+  Box left, right, beyond;
+  left.lo[0] = left.lo[1] = right.lo[1] = beyond.lo[1] = -1;
+  left.hi[0] = -0.25 * dx;
+  left.hi[1] = right.hi[1] = beyond.hi[1] = beyond.hi[0] = 1;
+  right.lo[0] = L - dx;
+  right.hi[0] = L;
+  beyond.lo[0] = L + 0.25 * dx;
+  g.region_names = {"left", "right", "beyond"};
+  g.regions = {left, right, beyond};
+  BoundaryCondition hold, pull, spin;
+  hold.name = "hold";
+  hold.kind = BoundaryCondition::Displacement;
+  hold.region_mask = 1u << 0;
+  pull.name = "pull";
+  pull.kind = BoundaryCondition::Traction;
+  pull.region_mask = 1u << 1;
+  pull.value = t;
+  pull.consistent = true;
+  pull.face = 1;  // +x
+  spin.name = "spin";
+  spin.kind = BoundaryCondition::MicroRotation;
+  spin.region_mask = 1u << 2;
+  spin.mirrored = spin.slaved = true;
+  const auto r = bar_to_rest(g, {hold, pull, spin}, 6000);
+  const double E = kLaw.young(), nu = kLaw.poisson();
+  const double strain = t * (1 - nu * nu) / E;
+  const double xa = 10.5 * dx, xb = 30.5 * dx, xe = L - 0.5 * dx;
+  const double ua = column_u(r, xa, dx), ub = column_u(r, xb, dx), ue = column_u(r, xe, dx);
+  const double measured = (ub - ua) / (xb - xa);
+  const double surface_length = (ue - (ub + measured * (xe - xb))) / measured;
+  std::printf("consistent with a slaved layer: strain ratio %.6f, loaded face's excess %.4f dx\n",
+              measured / strain, surface_length / dx);
+  EXPECT_NEAR(measured / strain, 1.0, 0.005);
+  EXPECT_NEAR(r.reaction, -t * H * g.thickness, 1e-4 * t * H) << "reaction";
+  EXPECT_LT(std::abs(surface_length), 1e-3 * dx) << surface_length / dx;
+}
+
 // Traction on the outer column (item 5 of the boundary-layer issue): the interior strain and
 // the reaction are exact; what the truncated families at the loaded face cost shows as the
 // loaded column's displacement beyond the interior's straight line, as a length: the face

@@ -354,13 +354,12 @@ TEST(SolidValidation, CosseratLayerBetweenSlavedClamps) {
   const double stiffness = cs.tau * cs.h / (cs.mu * cs.u(cs.h));
   EXPECT_NEAR(stiffness, 1.0426, 1e-4);  // VALIDATION.md's reference number
   for (const bool driven : {true, false}) {
-    ClampedLayer r[3];  // constant, slaved, slaved with the consistent traction (traction only)
-    for (int k = 0; k < (driven ? 2 : 3); ++k) {
-      r[k] = cosserat_layer_between_layers(k > 0, driven, 80, k == 2);
-      const std::string tag =
-          std::string(driven ? "driven" : "traction") + (k == 0   ? "_constant"
-                                                         : k == 1 ? "_slaved"
-                                                                  : "_slaved_consistent");
+    // constant, slaved; traction only: slaved and constant with the consistent traction
+    ClampedLayer r[4];
+    const char* names[4] = {"_constant", "_slaved", "_slaved_consistent", "_constant_consistent"};
+    for (int k = 0; k < (driven ? 2 : 4); ++k) {
+      r[k] = cosserat_layer_between_layers(k == 1 || k == 2, driven, 80, k >= 2);
+      const std::string tag = std::string(driven ? "driven" : "traction") + names[k];
       std::printf(
           "%s: tau %+.3f %%, u(h) %+.3f %%, top row %+.3f %%, u(h/2) %+.3f %%, "
           "theta(h/2) %+.3f %%, G_eff/mu %.5f (closed form %.5f)\n",

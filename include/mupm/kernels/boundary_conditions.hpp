@@ -5,6 +5,7 @@
 #ifndef MUPM_BOUNDARY_CONDITIONS_HPP
 #define MUPM_BOUNDARY_CONDITIONS_HPP
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -436,8 +437,11 @@ void body_force_density(const std::vector<BoundaryCondition>& bcs, const Points<
   for (const auto& bc : bcs) {
     if (bc.kinematic() || bc.fluid())
       continue;
-    if (bc.unit_load.extent(0) > 0) {
+    if (bc.consistent) {  // its load built by the solid solver (build_consistent_tractions)
       constexpr int R = kRotDim<Dim>;
+      if (bc.unit_load.extent(0) != pts.n_owned)
+        throw std::logic_error("body_force_density: consistent traction '" + bc.name +
+                               "' without its load");
       const double s = bc.value * bc.time(t);
       auto load = bc.unit_load;
       Kokkos::parallel_for(

@@ -680,6 +680,9 @@ class SolidSolver : public Mechanics {
   // consistent_traction_load): each such traction's load of a unit Value, from the families at
   // construction (bonds broken later leave it as it was), on the strip within 2 delta + dx of its
   // face whose other coordinates lie in the condition's region box.
+  // The slaved layers' marks first (initialize() repeats them; they only set bits): their points
+  // carry no stress and their forces fold, as in the run. Built here, not in initialize(), so
+  // that a restart, whose checkpoint breaks bonds in between, builds it from the same bonds.
   void build_consistent_tractions() {
     auto& p = disc_.points;
     const auto& g = disc_.grid;
@@ -687,8 +690,16 @@ class SolidSolver : public Mechanics {
     for (auto& bc : bcs_) {
       if (!bc.consistent)
         continue;
-      if (tmp.force.extent(0) == 0)
+      if (bc.face < 0 || bc.face >= 2 * Dim || bc.region_mask == 0 ||
+          (bc.region_mask & (bc.region_mask - 1)) != 0)
+        throw std::logic_error("SolidSolver: consistent traction '" + bc.name +
+                               "' needs its face and one region (input/model.cpp)");
+      if (tmp.force.extent(0) == 0) {
         tmp.allocate(p.size(), p.n_owned);
+        mark_fixed(bcs_, p);
+        if (mirrored_ || slaved_)
+          mark_mirrored_layers(bcs_, p, disc_.mirror);
+      }
       uniform_stress_forces(disc_, prm_, unit_traction_stress(Dim, bc.face, bc.component), tmp);
       if (slaved_)
         fold_layer_forces(disc_, slots_, tmp.force, tmp.moment, fold_);
