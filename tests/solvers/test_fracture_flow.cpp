@@ -98,6 +98,19 @@ double sum_owned(const Points<2>& p, F&& f) {
   return s;
 }
 
+// The least-squares line p_f = a x + b over the fracture points of region `mask`: (a, b).
+std::pair<double, double> fit_pf_along_x(const Points<2>& p, std::uint32_t mask) {
+  auto on = [&](std::size_t i) { return p.pf_saturation(i) > 0 && (p.regions(i) & mask); };
+  const double n = sum_owned(p, [&](std::size_t i) { return on(i) ? 1.0 : 0.0; });
+  const double sx = sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) : 0.0; });
+  const double sp = sum_owned(p, [&](std::size_t i) { return on(i) ? p.pf(i) : 0.0; });
+  const double sxx =
+      sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) * p.x(i, 0) : 0.0; });
+  const double sxp = sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) * p.pf(i) : 0.0; });
+  const double a = (n * sxp - sx * sp) / (n * sxx - sx * sx);
+  return {a, (sp - a * sx) / n};
+}
+
 // The network's direct solve (include/mupm/solvers/sparse_cholesky.hpp) on the shape of its
 // systems: a chain of n points with storage s and conductance c to the next two, in a
 // scrambled numbering (so the ordering matters), against the residual A x - b computed here;
@@ -189,15 +202,7 @@ TEST(FractureFlow, CubicLawSlot) {
   const double rate_out = -(q[1] - in[1]) / (prm.water_density * dt);  // leaves at the outlet
   // The gradient in the middle half, by least squares over its fracture points.
   auto& p = s.disc.points;
-  const std::uint32_t mid = 1u << 2;
-  auto on = [&](std::size_t i) { return p.pf_saturation(i) > 0 && (p.regions(i) & mid); };
-  const double n = sum_owned(p, [&](std::size_t i) { return on(i) ? 1.0 : 0.0; });
-  const double sx = sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) : 0.0; });
-  const double sp = sum_owned(p, [&](std::size_t i) { return on(i) ? p.pf(i) : 0.0; });
-  const double sxx =
-      sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) * p.x(i, 0) : 0.0; });
-  const double sxp = sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) * p.pf(i) : 0.0; });
-  const double grad = (n * sxp - sx * sp) / (n * sxx - sx * sx);
+  const double grad = fit_pf_along_x(p, 1u << 2).first;
   const double cubic = a * a * a * s.g.thickness * (-grad) / (12 * mu);
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -265,16 +270,8 @@ double layered_slot_gradient(bool mirrored, double& face_value) {
   const double water = fluid.fluid_mass() + fluid.fracture_flow()->mass() - mass0 - q[0] - q[1];
   EXPECT_LT(std::abs(water), 1e-9 * through) << "water not conserved";
   auto& p = disc.points;
-  const std::uint32_t mid = 1u << 2;
-  auto on = [&](std::size_t i) { return p.pf_saturation(i) > 0 && (p.regions(i) & mid); };
-  const double n = sum_owned(p, [&](std::size_t i) { return on(i) ? 1.0 : 0.0; });
-  const double sx = sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) : 0.0; });
-  const double sp = sum_owned(p, [&](std::size_t i) { return on(i) ? p.pf(i) : 0.0; });
-  const double sxx =
-      sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) * p.x(i, 0) : 0.0; });
-  const double sxp = sum_owned(p, [&](std::size_t i) { return on(i) ? p.x(i, 0) * p.pf(i) : 0.0; });
-  const double grad = (n * sxp - sx * sp) / (n * sxx - sx * sx);
-  face_value = (sp - grad * sx) / n;  // the fitted line at x = 0
+  const auto [grad, at0] = fit_pf_along_x(p, 1u << 2);
+  face_value = at0;  // the fitted line at x = 0
   return grad;
 }
 

@@ -64,6 +64,43 @@ BarResult bar_to_rest(const GridSpec<Dim>& g, std::vector<BoundaryCondition> bcs
   return r;
 }
 
+// The 2D bar of the traction tests: 40 x 8 of spacing dx, a layer of one horizon before x = 0
+// (region "left", held by `hold`), the traction t on the last column (region "right", `pull`,
+// consistent or on the outer row). Regions `extra` are added after those two.
+struct TractionBar {
+  GridSpec<2> g;
+  BoundaryCondition hold, pull;
+};
+TractionBar traction_bar(double dx, double factor, double t, bool consistent,
+                         std::vector<std::pair<std::string, Box>> extra = {}) {
+  TractionBar b;
+  b.g = test::box<2>({40, 8}, factor, dx);
+  b.g.layers[0] = {b.g.horizon_cells(), 0};
+  const double L = 40 * dx;
+  Box left, right;
+  left.lo[0] = left.lo[1] = right.lo[1] = -1;
+  left.hi[0] = -0.25 * dx;
+  left.hi[1] = right.hi[1] = 1;
+  right.lo[0] = L - dx;
+  right.hi[0] = L;
+  b.g.region_names = {"left", "right"};
+  b.g.regions = {left, right};
+  for (const auto& [name, box] : extra) {
+    b.g.region_names.push_back(name);
+    b.g.regions.push_back(box);
+  }
+  b.hold.name = "hold";
+  b.hold.kind = BoundaryCondition::Displacement;
+  b.hold.region_mask = 1u << 0;
+  b.pull.name = "pull";
+  b.pull.kind = BoundaryCondition::Traction;
+  b.pull.region_mask = 1u << 1;
+  b.pull.value = t;
+  b.pull.consistent = consistent;
+  b.pull.face = 1;  // +x
+  return b;
+}
+
 // Mean u_x of the lattice column at x (all rows of the body and its layers).
 double column_u(const BarResult& r, double x, double dx) {
   double sum = 0;
@@ -77,52 +114,43 @@ double column_u(const BarResult& r, double x, double dx) {
   return sum / std::max(n, 1);
 }
 
+// The loaded column's (at xe) displacement beyond the straight line through the columns at xa and
+// xb, as a length (the face acts as if it sat that much farther out); `strain`: the line's slope.
+double loaded_face_excess(const BarResult& r, double dx, double xa, double xb, double xe,
+                          double& strain) {
+  const double ua = column_u(r, xa, dx), ub = column_u(r, xb, dx), ue = column_u(r, xe, dx);
+  strain = (ub - ua) / (xb - xa);
+  return (ue - (ub + strain * (xe - xb))) / strain;
+}
+
 // A bar under a consistent traction whose loaded face has a slaved layer beyond it (theta = 0
 // Mirrored on it, u free there: the traction-loaded face of the Cosserat layer in
 // test_solid_validation.cpp, through the solver): the uniform tension (theta = 0) continues into
 // the layer, so the loaded column stays on the interior's line. Built before the layer's points
 // were marked energy-free, the load would balance stresses those points do not carry.
 TEST(SolidSolver, ConsistentTractionWithSlavedLayer) {
-  const double dx = 2.5e-3, t = 1e5;
-  auto g = test::box<2>({40, 8}, 3.015, dx);
-  g.layers[0] = {g.horizon_cells(), 2 * g.horizon_cells()};
-  g.mirrored_layers = true;
-  const double L = 40 * dx, H = 8 * dx;
-  Box left, right, beyond;
-  left.lo[0] = left.lo[1] = right.lo[1] = beyond.lo[1] = -1;
-  left.hi[0] = -0.25 * dx;
-  left.hi[1] = right.hi[1] = beyond.hi[1] = beyond.hi[0] = 1;
-  right.lo[0] = L - dx;
-  right.hi[0] = L;
+  const double dx = 2.5e-3, t = 1e5, L = 40 * dx;
+  Box beyond;
   beyond.lo[0] = L + 0.25 * dx;
-  g.region_names = {"left", "right", "beyond"};
-  g.regions = {left, right, beyond};
-  BoundaryCondition hold, pull, spin;
-  hold.name = "hold";
-  hold.kind = BoundaryCondition::Displacement;
-  hold.region_mask = 1u << 0;
-  pull.name = "pull";
-  pull.kind = BoundaryCondition::Traction;
-  pull.region_mask = 1u << 1;
-  pull.value = t;
-  pull.consistent = true;
-  pull.face = 1;  // +x
+  beyond.lo[1] = -1;
+  beyond.hi[0] = beyond.hi[1] = 1;
+  auto b = traction_bar(dx, 3.015, t, true, {{"beyond", beyond}});
+  b.g.layers[0][1] = 2 * b.g.horizon_cells();
+  b.g.mirrored_layers = true;
+  BoundaryCondition spin;
   spin.name = "spin";
   spin.kind = BoundaryCondition::MicroRotation;
   spin.region_mask = 1u << 2;
   spin.mirrored = spin.slaved = true;
-  const auto r = bar_to_rest(g, {hold, pull, spin}, 6000);
-  const double E = kLaw.young(), nu = kLaw.poisson();
-  const double strain = t * (1 - nu * nu) / E;
-  const double xa = 10.5 * dx, xb = 30.5 * dx, xe = L - 0.5 * dx;
-  const double ua = column_u(r, xa, dx), ub = column_u(r, xb, dx), ue = column_u(r, xe, dx);
-  const double measured = (ub - ua) / (xb - xa);
-  const double surface_length = (ue - (ub + measured * (xe - xb))) / measured;
+  const auto r = bar_to_rest(b.g, {b.hold, b.pull, spin}, 6000);
+  const double strain = t * (1 - kLaw.poisson() * kLaw.poisson()) / kLaw.young();
+  double measured = 0;
+  const double excess = loaded_face_excess(r, dx, 10.5 * dx, 30.5 * dx, L - 0.5 * dx, measured);
   std::printf("consistent with a slaved layer: strain ratio %.6f, loaded face's excess %.4f dx\n",
-              measured / strain, surface_length / dx);
+              measured / strain, excess / dx);
   EXPECT_NEAR(measured / strain, 1.0, 0.005);
-  EXPECT_NEAR(r.reaction, -t * H * g.thickness, 1e-4 * t * H) << "reaction";
-  EXPECT_LT(std::abs(surface_length), 1e-3 * dx) << surface_length / dx;
+  EXPECT_NEAR(r.reaction, -t * 8 * dx * b.g.thickness, 1e-4 * t * 8 * dx) << "reaction";
+  EXPECT_LT(std::abs(excess), 1e-3 * dx) << excess / dx;
 }
 
 // Traction on the outer column (item 5 of the boundary-layer issue): the interior strain and
@@ -134,37 +162,15 @@ TEST(SolidSolver, ConsistentTractionWithSlavedLayer) {
 // loaded column continues the interior's straight line: no excess beyond round-off and the
 // iteration's rest (asserted below 1e-3 dx; the outer row's excess is 0.1-0.2 dx).
 TEST(SolidSolver, BarUnderTraction) {
-  const double dx = 2.5e-3, t = 1e5;
+  const double dx = 2.5e-3, t = 1e5, L = 40 * dx, H = 8 * dx;
   for (const bool consistent : {false, true}) {
     for (const double factor : {3.015, 4.015}) {
-      auto g = test::box<2>({40, 8}, factor, dx);
-      g.layers[0] = {g.horizon_cells(), 0};
-      const double L = 40 * dx, H = 8 * dx;
-      Box left, right;
-      left.lo[0] = left.lo[1] = right.lo[1] = -1;
-      left.hi[0] = -0.25 * dx;
-      left.hi[1] = right.hi[1] = 1;
-      right.lo[0] = L - dx;
-      right.hi[0] = L;
-      g.region_names = {"left", "right"};
-      g.regions = {left, right};
-      BoundaryCondition hold, pull;
-      hold.name = "hold";
-      hold.kind = BoundaryCondition::Displacement;
-      hold.region_mask = 1u << 0;
-      pull.name = "pull";
-      pull.kind = BoundaryCondition::Traction;
-      pull.region_mask = 1u << 1;
-      pull.value = t;
-      pull.consistent = consistent;
-      pull.face = 1;  // +x
-      const auto r = bar_to_rest(g, {hold, pull}, 6000);
-      const double E = kLaw.young(), nu = kLaw.poisson();
-      const double strain = t * (1 - nu * nu) / E;
-      const double xa = 10.5 * dx, xb = 30.5 * dx, xe = L - 0.5 * dx;
-      const double ua = column_u(r, xa, dx), ub = column_u(r, xb, dx), ue = column_u(r, xe, dx);
-      const double measured = (ub - ua) / (xb - xa);
-      const double surface_length = (ue - (ub + measured * (xe - xb))) / measured;
+      const auto b = traction_bar(dx, factor, t, consistent);
+      const auto r = bar_to_rest(b.g, {b.hold, b.pull}, 6000);
+      const double strain = t * (1 - kLaw.poisson() * kLaw.poisson()) / kLaw.young();
+      double measured = 0;
+      const double surface_length =
+          loaded_face_excess(r, dx, 10.5 * dx, 30.5 * dx, L - 0.5 * dx, measured);
       const std::string tag = std::string(consistent ? "_consistent" : "_outer_row") + "_delta" +
                               std::to_string(int(factor));
       RecordProperty("strain_ratio" + tag, std::to_string(measured / strain));
@@ -174,7 +180,7 @@ TEST(SolidSolver, BarUnderTraction) {
           consistent ? "consistent" : "outer row", factor, measured / strain, surface_length / dx,
           100 * surface_length / L);
       EXPECT_NEAR(measured / strain, 1.0, 0.005) << measured << " vs " << strain;
-      EXPECT_NEAR(r.reaction, -t * H * g.thickness, 1e-4 * t * H) << "reaction";
+      EXPECT_NEAR(r.reaction, -t * H * b.g.thickness, 1e-4 * t * H) << "reaction";
       if (consistent) {
         EXPECT_LT(std::abs(surface_length), 1e-3 * dx) << surface_length / dx;
       }
@@ -214,10 +220,9 @@ TEST(SolidSolver, BarUnderTraction3D) {
     pull.face = 1;  // +x
     const auto r = bar_to_rest(g, {hold, pull}, 4000);
     const double strain = t / kLaw.young();
-    const double xa = 7.5 * dx, xb = 12.5 * dx, xe = L - 0.5 * dx;
-    const double ua = column_u(r, xa, dx), ub = column_u(r, xb, dx), ue = column_u(r, xe, dx);
-    const double measured = (ub - ua) / (xb - xa);
-    const double surface_length = (ue - (ub + measured * (xe - xb))) / measured;
+    double measured = 0;
+    const double surface_length =
+        loaded_face_excess(r, dx, 7.5 * dx, 12.5 * dx, L - 0.5 * dx, measured);
     std::printf("3D %s: strain ratio %.6f, loaded face's excess %.4f dx\n",
                 consistent ? "consistent" : "outer row", measured / strain, surface_length / dx);
     RecordProperty(std::string("surface_length_over_dx_3d_") + (consistent ? "consistent" : "row"),
