@@ -674,8 +674,6 @@ class SolidSolver : public Mechanics {
   static bool slaved_velocity(const BoundaryCondition& bc) {
     return bc.slaved && bc.kind == BoundaryCondition::Velocity;
   }
-  // The slaved layer points' forces and moments onto their mirrors (pack_layer_forces), across
-  // ranks. The layer points keep theirs: the reactions and the external work are made of them.
   // Traction Distribution = Consistent (kernels/boundary_conditions.hpp,
   // consistent_traction_load): each such traction's load of a unit Value, from the families at
   // construction (bonds broken later leave it as it was), on the strip within 2 delta + dx of its
@@ -720,6 +718,8 @@ class SolidSolver : public Mechanics {
     }
   }
 
+  // The slaved layer points' forces and moments onto their mirrors (pack_layer_forces), across
+  // ranks. The layer points keep theirs: the reactions and the external work are made of them.
   void fold_layers() {
     if (!slaved_)
       return;
