@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <vector>
 
 #include "mupm/kernels/shape_tensor.hpp"
 #include "test_utils.hpp"
@@ -110,15 +111,27 @@ TEST(Neighbors, CrackTipBondsAgreeBothWays) {
   auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.offsets);
   auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.neighbor);
   auto intact = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.bonds.intact);
-  std::map<std::pair<GlobalId, GlobalId>, int> state;  // owned ends only: every pair on 1 rank
+  // Every directed bond (i, j, intact) of every rank, gathered on each rank.
+  std::vector<long long> mine;
   for (std::size_t i = 0; i < pts.n_owned; ++i)
     for (BondIndex b = off(i); b < off(i + 1); ++b)
-      state[{gid(i), gid(nb(b))}] = intact(b);
+      mine.insert(mine.end(), {(long long)gid(i), (long long)gid(nb(b)), (long long)intact(b)});
+  int size = 0, count = int(mine.size());
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  std::vector<int> counts(size), displs(size, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  for (int r = 1; r < size; ++r)
+    displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<long long> all(std::size_t(displs[size - 1] + counts[size - 1]));
+  MPI_Allgatherv(mine.data(), count, MPI_LONG_LONG, all.data(), counts.data(), displs.data(),
+                 MPI_LONG_LONG, MPI_COMM_WORLD);
+  std::map<std::pair<long long, long long>, long long> state;
+  for (std::size_t k = 0; k < all.size(); k += 3)
+    state[{all[k], all[k + 1]}] = all[k + 2];
   long long pairs = 0, broken = 0;
   for (const auto& [key, ok] : state) {
     const auto back = state.find({key.second, key.first});
-    if (back == state.end())
-      continue;  // the other end lives on another rank
+    ASSERT_TRUE(back != state.end()) << key.first << " -> " << key.second << " has no copy";
     ++pairs;
     broken += ok ? 0 : 1;
     EXPECT_EQ(ok, back->second) << key.first << " -> " << key.second;
