@@ -1,19 +1,41 @@
 #!/usr/bin/env bash
 # One command for a fresh Debian 12 machine (idempotent): set-up (Debian packages, cached OpenMP
-# Trilinos), configure and build mupm in ./build, then
-#   bash cmake/bootstrap.sh quickstart   run inputs/quickstart.xml on 2 ranks (build/quickstart)
-#   bash cmake/bootstrap.sh test         run the test suite (ctest)
-#   bash cmake/bootstrap.sh build        only build
-#   bash cmake/bootstrap.sh sanitize     build with ASan + UBSan in ./build-sanitize instead and run
-#                                        the test suite there (ctest)
+# Trilinos), configure mupm in ./build, build what the command uses, then
+#   bash cmake/bootstrap.sh quickstart   build mupm alone, run inputs/quickstart.xml on 2 ranks
+#                                        (build/quickstart)
+#   bash cmake/bootstrap.sh test         build mupm and its tests, run every test (ctest)
+#   bash cmake/bootstrap.sh build        build everything (mupm, tests, benchmarks)
+#   bash cmake/bootstrap.sh sanitize     build mupm and its tests with ASan + UBSan in
+#                                        ./build-sanitize instead and run the tests labelled
+#                                        sanitize there (ctest -L sanitize)
+# Each stage's time is printed at the end ("[mupm] times: ...").
 set -euo pipefail
 what=${1:-build}
+case "$what" in
+  build | quickstart | test | sanitize) ;;
+  *)
+    echo "usage: bash cmake/bootstrap.sh [build|quickstart|test|sanitize]" >&2
+    exit 1
+    ;;
+esac
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
+
+t0=$SECONDS
+times=""
+stage() {  # stage NAME: the time since the last stage, added to the summary
+  times+="${times:+, }$1 $((SECONDS - t0)) s"
+  t0=$SECONDS
+}
+trap '[[ -n $times ]] && echo "[mupm] times ($what): $times"' EXIT
 
 prefix_line=$(bash cmake/setup.sh | tail -n 1)
 prefix=${prefix_line#MUPM_TRILINOS_PREFIX=}
 jobs=$(nproc)
+stage set-up
+# The targets the tests run (the tests' CMakeLists: mupm, the GoogleTest binary, the kernels'
+# MPI-free compile check).
+test_targets=(mupm mupm_tests mupm_kernels_free_of_mpi)
 
 if [[ $what == sanitize ]]; then
   # mupm (not Trilinos) instrumented with AddressSanitizer + UndefinedBehaviorSanitizer. The options
@@ -22,18 +44,26 @@ if [[ $what == sanitize ]]; then
     -DMUPM_ENABLE_BENCHMARKS=OFF -DCMAKE_PREFIX_PATH="$prefix" >build-configure.log 2>&1 ||
     { cat build-configure.log; exit 1; }
   rm -f build-configure.log
-  cmake --build build-sanitize -j"$jobs"
+  cmake --build build-sanitize -j"$jobs" --target "${test_targets[@]}"
+  stage build
   # Open MPI leaks at exit by design: no leak checking here (README: checking leaks by hand).
   export ASAN_OPTIONS=detect_leaks=0
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-  ctest --test-dir build-sanitize --output-on-failure -j"$jobs"
+  ctest --test-dir build-sanitize --output-on-failure -j"$jobs" -L sanitize
+  stage ctest
   exit
 fi
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" >build-configure.log 2>&1 ||
   { cat build-configure.log; exit 1; }
 rm -f build-configure.log
-cmake --build build -j"$jobs"
+case "$what" in
+  quickstart) targets=(mupm) ;;
+  test) targets=("${test_targets[@]}") ;;
+  *) targets=(all) ;;
+esac
+cmake --build build -j"$jobs" --target "${targets[@]}"
+stage build
 
 case "$what" in
   quickstart)
@@ -52,13 +82,10 @@ case "$what" in
     mkdir -p build/quickstart && cd build/quickstart
     mpirun "${mpirun_flags[@]}" -np 2 ../mupm "$root/inputs/quickstart.xml"
     echo "Output in $root/build/quickstart/output: open fields.xmf in ParaView (Xdmf reader)."
+    stage run
     ;;
   test)
     ctest --test-dir build --output-on-failure -j"$jobs"
-    ;;
-  build) ;;
-  *)
-    echo "usage: bash cmake/bootstrap.sh [build|quickstart|test|sanitize]" >&2
-    exit 1
+    stage ctest
     ;;
 esac

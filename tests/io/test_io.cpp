@@ -157,7 +157,7 @@ std::vector<long long> read_gids(long long n) {
 
 }  // namespace
 
-TEST(Hdf5Io, DoubleRoundTripOnOtherDistribution) {
+TEST(IoHdf5, DoubleRoundTripOnOtherDistribution) {
   TempFiles tmp;
   const std::string path = tmp.add("double.h5");
   const long long n = 20011;
@@ -197,7 +197,7 @@ TEST(Hdf5Io, DoubleRoundTripOnOtherDistribution) {
   }
 }
 
-TEST(Hdf5Io, IntegerTypesRoundTrip) {
+TEST(IoHdf5, IntegerTypesRoundTrip) {
   TempFiles tmp;
   const std::string path = tmp.add("ints.h5");
   const long long n = 517;
@@ -223,7 +223,7 @@ TEST(Hdf5Io, IntegerTypesRoundTrip) {
   }
 }
 
-TEST(Hdf5Io, OneRankOwnsNothing) {
+TEST(IoHdf5, OneRankOwnsNothing) {
   TempFiles tmp;
   const std::string path = tmp.add("empty_rank.h5");
   const long long n = 64;
@@ -254,7 +254,7 @@ TEST(Hdf5Io, OneRankOwnsNothing) {
   }
 }
 
-TEST(Hdf5Io, ErrorsThrowOnEveryRank) {
+TEST(IoHdf5, ErrorsThrowOnEveryRank) {
   TempFiles tmp;
   const std::string path = tmp.add("errors.h5");
   const long long n = 40;
@@ -302,7 +302,7 @@ TEST(Hdf5Io, ErrorsThrowOnEveryRank) {
   EXPECT_EQ(out, data);
 }
 
-TEST(Hdf5Io, OpenFailureThrowsOnEveryRank) {
+TEST(IoHdf5, OpenFailureThrowsOnEveryRank) {
   const std::string missing = tmp_prefix() + "does_not_exist.h5";
   expect_throw_everywhere([&] { PointFile::open(MPI_COMM_WORLD, missing); }, missing);
   const std::string bad_dir = tmp_prefix() + "no_such_dir/file.h5";
@@ -318,7 +318,7 @@ TEST(Hdf5Io, OpenFailureThrowsOnEveryRank) {
   expect_throw_everywhere([&] { PointFile::open(MPI_COMM_WORLD, text); }, text);
 }
 
-TEST(Hdf5Io, AttributesAndGlobals) {
+TEST(IoHdf5, AttributesAndGlobals) {
   TempFiles tmp;
   const std::string path = tmp.add("attrs.h5");
   const std::vector<double> g{1.5, -2.25, std::acos(-1.0), 1e-300};
@@ -383,7 +383,7 @@ std::string basename_of(const std::string& p) {
 
 }  // namespace
 
-TEST(Xdmf, TwoStepsReferenceExistingDatasets) {
+TEST(IoXdmf, TwoStepsReferenceExistingDatasets) {
   TempFiles tmp;
   const long long n = 37;
   const int dim = 2;
@@ -468,7 +468,7 @@ TEST(Xdmf, TwoStepsReferenceExistingDatasets) {
   }
 }
 
-TEST(Csv, HeaderRowsAppendAndErrors) {
+TEST(IoCsv, HeaderRowsAppendAndErrors) {
   if (rank_of() != 0) {
     return;  // CsvWriter is used on one rank
   }

@@ -13,7 +13,7 @@
 namespace mupm {
 namespace {
 
-TEST(Retention, VanGenuchtenMualemValidationNumbers) {
+TEST(FluidRetention, VanGenuchtenMualemValidationNumbers) {
   // VALIDATION §5: s_a = 10 kPa, n = 2, m = 1 - 1/n.
   const auto vg = VanGenuchten::mualem(10e3, 2.0);
   EXPECT_DOUBLE_EQ(vg.m, 0.5);

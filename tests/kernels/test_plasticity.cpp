@@ -79,7 +79,7 @@ ShearClosedForm simple_shear(const MicropolarElastic& el, const DruckerPragerPar
   return r;
 }
 
-TEST(DruckerPrager, SimpleShearAgainstClosedFormOneStepOrAThousand) {
+TEST(PlasticityDruckerPrager, SimpleShearAgainstClosedFormOneStepOrAThousand) {
   const auto el = soil();
   const auto dp = example3();
   const Consts k(dp);
@@ -133,7 +133,7 @@ TEST(DruckerPrager, SimpleShearAgainstClosedFormOneStepOrAThousand) {
 // elastic, negative on the softening branch (tau falls as gamma grows, at the rate
 // mu (1 - 3 mu / (3 mu + 3 a1 a3 K + k h)) < 0 for h < 0), positive again at the residual
 // cohesion (perfect plasticity with dilatancy against the isochoric constraint hardens).
-TEST(DruckerPrager, SecondOrderWorkSignAlongSimpleShear) {
+TEST(PlasticityDruckerPrager, SecondOrderWorkSignAlongSimpleShear) {
   const auto el = soil();
   const auto dp = example3();
   const Consts k(dp);
@@ -155,7 +155,7 @@ TEST(DruckerPrager, SecondOrderWorkSignAlongSimpleShear) {
 
 // Curvature only (eps = 0): m = B kappa^e, q = sqrt(3/2) |m| / l,
 //   x = (q_t - k c0) / (3/4 mu + 3 a1 a3 K + k h), m = m_t q / q_t, q = q_t - 3/4 mu x.
-TEST(DruckerPrager, CurvatureOnlyAgainstClosedForm) {
+TEST(PlasticityDruckerPrager, CurvatureOnlyAgainstClosedForm) {
   const auto el = soil();
   const auto dp = example3();
   const Consts k(dp);
@@ -190,7 +190,7 @@ TEST(DruckerPrager, CurvatureOnlyAgainstClosedForm) {
 // phi = psi = 0 is von Mises: q = k c with k = 2/sqrt3, no plastic volume change, the same
 // deviatoric response under any added mean strain, and (m = 0) the classical radial return
 // s = s_t (1 - 3 mu x / q_t), x = (q_t - k c0) / (3 mu + k h), on a non-proportional strain.
-TEST(DruckerPrager, ZeroAnglesAreVonMises) {
+TEST(PlasticityDruckerPrager, ZeroAnglesAreVonMises) {
   const auto el = soil();
   auto dp = example3();
   dp.friction = dp.dilation = 0;
@@ -231,7 +231,7 @@ TEST(DruckerPrager, ZeroAnglesAreVonMises) {
 // Random strains, wryness and start states: f <= tolerance after every return, the
 // dissipation sigma : d eps^p + m : d kappa^p >= 0, tr d eps^p >= 0 with psi > 0 (= 0 with
 // psi = 0), the skew stress untouched, sigma = C (eps - eps^p) and m = B (kappa - kappa^p).
-TEST(DruckerPrager, ReturnInvariantsOnRandomStates) {
+TEST(PlasticityDruckerPrager, ReturnInvariantsOnRandomStates) {
   const auto el = soil();
   std::mt19937 gen(7);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -304,7 +304,7 @@ TEST(DruckerPrager, ReturnInvariantsOnRandomStates) {
 }
 
 // Plane strain: the 2D law is the 3D one with eps_zz = 0 and no out-of-plane shear.
-TEST(DruckerPrager, PlaneStrainIsThe3DLawWithZeroOutOfPlaneStrain) {
+TEST(PlasticityDruckerPrager, PlaneStrainIsThe3DLawWithZeroOutOfPlaneStrain) {
   const auto el = soil();
   const auto dp = example3(25);
   const double e2[4] = {0.01, 0.02, -0.005, -0.015}, k2[2] = {1.5, -2.0};

@@ -203,7 +203,7 @@ void check_shape_tensor(double factor, double k11_units, long long n_neighbors) 
   EXPECT_EQ(total, 1);
 }
 
-TEST(ShapeTensor, ValidationTable) {
+TEST(NeighborsShapeTensor, ValidationTable) {
   check_shape_tensor<2>(3.015, 68, 28);
   check_shape_tensor<2>(4.015, 192, 48);
   check_shape_tensor<3>(3.015, 236, 122);

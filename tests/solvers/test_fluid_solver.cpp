@@ -496,7 +496,7 @@ TerzaghiResult solve_terzaghi(int N, bool mirrored, double skip, double transits
 }
 }  // namespace
 
-TEST(HydroMechanical, TerzaghiConsolidation) {
+TEST(FluidSolverLong, TerzaghiConsolidation) {
   const double* Tvs = kTvs;
   using Result = TerzaghiResult;
   const Result coarse = solve_terzaghi(10, false, 3), fine = solve_terzaghi(20, false, 3);
@@ -523,7 +523,7 @@ TEST(HydroMechanical, TerzaghiConsolidation) {
 // at T_v = 0.1, 0.2, 0.5 (the paper's constant layers in the same column for comparison: H = 20 dx
 // 10.9, 7.7, 5.6 %, U off by 5.4, 5.7, 5.2 %): H = 20 dx 0.83, 0.39, 0.51 %, U off by 0.06,
 // 0.19, 0.34 %; H = 40 dx 0.67, 0.15, 0.25 %.
-TEST(HydroMechanical, TerzaghiMirroredLayers) {
+TEST(FluidSolverLong, TerzaghiMirroredLayers) {
   const TerzaghiResult r20 = solve_terzaghi(20, true, 2, 1600),
                        r40 = solve_terzaghi(40, true, 2, 1600);
   for (int k = 0; k < 3; ++k) {
@@ -536,7 +536,7 @@ TEST(HydroMechanical, TerzaghiMirroredLayers) {
 
 // Solid First and Fluid First are two first-order splittings of the same equations: their
 // pore pressures after the load ramp differ by O(dt), so halving dt halves the difference.
-TEST(HydroMechanical, StaggeringOrdersAgreeAsDtShrinks) {
+TEST(FluidSolverHydroMechanical, StaggeringOrdersAgreeAsDtShrinks) {
   Terzaghi tz;
   const double t_end = 1.5 * tz.t_r;
   double diff[2];
@@ -574,7 +574,7 @@ namespace {
 // applies.) The compressed water takes most of the work (its
 // undrained modulus K_w/phi is 10 M here), so W_pore is negative and larger than the strain
 // energy: a wrong sign or factor of the pore work, or of p* in the stress, breaks the balance.
-TEST(HydroMechanical, SolidEnergyBalanceWithPoreWork) {
+TEST(FluidSolverHydroMechanical, SolidEnergyBalanceWithPoreWork) {
   Terzaghi tz;
   ColumnRun run(tz, 8, false, 0.5, false);
   const double b0 = run.solid->energy().balance();
@@ -604,7 +604,7 @@ namespace {
 // the consolidation column after the load ramp, a fluid step every 2 solid steps (over their
 // interval) and 3 fluid substeps per solid step give pore pressures within 1e-2 p0 of the
 // one-to-one step (the two staggering orders differ by about 1e-3 p0 at this step).
-TEST(HydroMechanical, SubcyclingAgrees) {
+TEST(FluidSolverHydroMechanical, SubcyclingAgrees) {
   Terzaghi tz;
   const double t_end = 1.5 * tz.t_r;
   ColumnRun base(tz, 8, false, 0.4), every2(tz, 8, false, 0.4), sub3(tz, 8, true, 0.4);

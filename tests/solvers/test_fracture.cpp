@@ -264,7 +264,7 @@ TEST(Fracture, StraightCrackReleasesGcr2D) {
   expect_energy_release<2>(o, factor);
 }
 
-TEST(Fracture, StraightCrackReleasesGcr3D) {
+TEST(FractureLong, StraightCrackReleasesGcr3D) {
   const double factor = 3.05;
   const Opening o = open_crack<3>({12, 10, 12}, factor, 1e-4, 500);
   expect_energy_release<3>(o, factor);
@@ -276,7 +276,7 @@ TEST(Fracture, StraightCrackReleasesGcr3D) {
 // later than in the dry body (here some do not break at all by the end of the ramp); the
 // effective state is the skeleton's alone and breaks them on the very same steps as the dry
 // body, releasing the same energy.
-TEST(Fracture, BondEnergyOfEffectiveAndTotalForceState) {
+TEST(FractureLong, BondEnergyOfEffectiveAndTotalForceState) {
   const double factor = 3.015, p0 = 2e6;
   const Opening dry = open_crack<2>({24, 12}, factor, 1e-4, 2000);
   const Opening eff = open_crack<2>({24, 12}, factor, 1e-4, 2000, p0, true);

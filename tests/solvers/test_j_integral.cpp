@@ -117,9 +117,9 @@ KField centre_field(bool mode2) {
   return f;
 }
 
-class KFieldJ : public ::testing::TestWithParam<bool> {};
+class JIntegralKField : public ::testing::TestWithParam<bool> {};
 
-TEST_P(KFieldJ, MatchesLefmOnEveryContour) {
+TEST_P(JIntegralKField, MatchesLefmOnEveryContour) {
   const bool mode2 = GetParam();
   Plate p = cracked_plate(80, kClassical);
   const auto& law = kClassical;
@@ -150,7 +150,7 @@ TEST_P(KFieldJ, MatchesLefmOnEveryContour) {
   EXPECT_LT((hi - lo) / exact, 0.005) << "path independence";
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, KFieldJ, ::testing::Values(false, true));
+INSTANTIATE_TEST_SUITE_P(Modes, JIntegralKField, ::testing::Values(false, true));
 
 // Intact bonds (over all ranks) that cross the horizontal segment y = yc, x in [x0, x1]: the
 // test's own geometry.
@@ -332,9 +332,9 @@ std::vector<JIntegral<2>::Value> j_of(StaticPlate& P, const std::vector<double>&
 // The LEFM check of the issue: a single-edge-cracked strip (height 3W) in tension, mu_c and l
 // small: J against K_I^2 (1 - nu^2)/E with K_I = sigma sqrt(pi a) F(a/W), at a/W = 0.3 and 0.5,
 // on four contours.
-class SentJ : public ::testing::TestWithParam<double> {};
+class JIntegralSentLong : public ::testing::TestWithParam<double> {};
 
-TEST_P(SentJ, MatchesLefm) {
+TEST_P(JIntegralSentLong, MatchesLefm) {
   const double aw = GetParam(), dx = 1e-3, sigma = 1e6;
   const int nx = 60;
   auto P = static_plate(nx, 3 * nx, dx, 3.0, aw * nx * dx, kClassical);
@@ -361,7 +361,7 @@ TEST_P(SentJ, MatchesLefm) {
   EXPECT_LT((hi - lo) / exact, 0.05) << "path independence";
 }
 
-INSTANTIATE_TEST_SUITE_P(JStatic, SentJ, ::testing::Values(0.3, 0.5));
+INSTANTIATE_TEST_SUITE_P(JStatic, JIntegralSentLong, ::testing::Values(0.3, 0.5));
 
 // J is the energy released per unit crack advance, micro-rotational part included: under fixed
 // loads, G = -(Pi(a + da) - Pi(a))/da of the static solutions for the crack lengths a and
@@ -374,9 +374,9 @@ struct Release {
   bool mode2;
   double l;
 };
-class ReleasedEnergy : public ::testing::TestWithParam<Release> {};
+class JIntegralReleasedEnergyLong : public ::testing::TestWithParam<Release> {};
 
-TEST_P(ReleasedEnergy, EqualsJ) {
+TEST_P(JIntegralReleasedEnergyLong, EqualsJ) {
   const bool mode2 = GetParam().mode2;
   const double dx = 1e-3, load = 1e6;
   const int n = 60;
@@ -430,16 +430,16 @@ TEST_P(ReleasedEnergy, EqualsJ) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(JStatic, ReleasedEnergy,
+INSTANTIATE_TEST_SUITE_P(JStatic, JIntegralReleasedEnergyLong,
                          ::testing::Values(Release{false, 4e-3}, Release{true, 4e-3},
                                            Release{true, 30e-3}));
 
 // Example 2 at reduced size (60 x 60 points of 1 mm, crack 30 mm, static): J falls as the
 // micropolar length l = delta grows, in mode I (tension 1 MPa) and mode II (shear 1 MPa on the
 // top row, bottom row held), as in the paper's Tables 1 and 3.
-class Example2Reduced : public ::testing::TestWithParam<bool> {};
+class JIntegralExample2Long : public ::testing::TestWithParam<bool> {};
 
-TEST_P(Example2Reduced, JFallsAsLengthScaleGrows) {
+TEST_P(JIntegralExample2Long, JFallsAsLengthScaleGrows) {
   const bool mode2 = GetParam();
   const double dx = 1e-3;
   const int n = 60;
@@ -470,7 +470,7 @@ TEST_P(Example2Reduced, JFallsAsLengthScaleGrows) {
   EXPECT_LT(J[1], J[0]);
 }
 
-INSTANTIATE_TEST_SUITE_P(JStatic, Example2Reduced, ::testing::Values(false, true));
+INSTANTIATE_TEST_SUITE_P(JStatic, JIntegralExample2Long, ::testing::Values(false, true));
 
 }  // namespace
 }  // namespace mupm

@@ -71,7 +71,7 @@ std::vector<double> eq42_by_bonds(test::Body<2>& b, const Snapshot& A, const Sna
 }
 
 // A non-affine deformation: the field of eq 40 equals the bond sum of eq 42 at every point.
-TEST(SecondOrderWork, PointFieldIsTheBondSumOfEq42) {
+TEST(ShearBandsSecondOrderWork, PointFieldIsTheBondSumOfEq42) {
   test::Body<2> b(test::box<2>({24, 20}, 3.05, 2e-3), kLaw, 0.1);
   auto& p = b.pts();
   Vectors start("start", p.size(), 2 * (4 + 2));
@@ -109,7 +109,7 @@ TEST(SecondOrderWork, PointFieldIsTheBondSumOfEq42) {
 // Homogeneous deformation from rest: d2E = sigma : eps (+ m : kappa = 0) with eps of the
 // affine field (eps_xy = du_x/dy + theta, eps_yx = du_y/dx - theta) and sigma of eq 80, at every
 // point (an affine field is reproduced exactly, boundary points too).
-TEST(SecondOrderWork, HomogeneousDeformationGivesSigmaColonEps) {
+TEST(ShearBandsSecondOrderWork, HomogeneousDeformationGivesSigmaColonEps) {
   test::Body<2> b(test::box<2>({16, 16}, 3.05, 2e-3), kLaw, 0.1);
   auto& p = b.pts();
   Vectors start("start", p.size(), 12);

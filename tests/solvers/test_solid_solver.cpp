@@ -161,7 +161,7 @@ TEST(SolidSolver, ConsistentTractionWithSlavedLayer) {
 // consistent_traction_load) the uniform stress is in equilibrium up to the loaded face, so the
 // loaded column continues the interior's straight line: no excess beyond round-off and the
 // iteration's rest (asserted below 1e-3 dx; the outer row's excess is 0.1-0.2 dx).
-TEST(SolidSolver, BarUnderTraction) {
+TEST(SolidSolverLong, BarUnderTraction) {
   const double dx = 2.5e-3, t = 1e5, L = 40 * dx, H = 8 * dx;
   for (const bool consistent : {false, true}) {
     for (const double factor : {3.015, 4.015}) {
@@ -281,7 +281,7 @@ double end_displacement_bar(bool mirrored, int horizons, double& reaction_ratio)
   return measured / strain;
 }
 
-TEST(SolidSolver, BarUnderEndDisplacement) {
+TEST(SolidSolverLong, BarUnderEndDisplacement) {
   // Measured once with one-horizon mirrored layers (L = 60 dx): 1.0053, the layer's outer
   // points' truncated families (README); not rerun here.
   double reaction_constant = 0, reaction_mirrored = 0;
@@ -345,7 +345,7 @@ double clamped_bar(bool slaved, double& reaction_ratio) {
   return measured / strain;
 }
 
-TEST(SolidSolver, BarBetweenSlavedClamps) {
+TEST(SolidSolverLong, BarBetweenSlavedClamps) {
   double reaction_constant = 0, reaction_slaved = 0;
   const double constant = clamped_bar(false, reaction_constant);
   const double slaved = clamped_bar(true, reaction_slaved);
@@ -504,7 +504,7 @@ TEST(SolidSolver, SlavedVelocityLayerMovesAsDisplacement) {
 // so theta = m / (4 mu_c) (uniform: no couple stress, and free faces need d theta/dn = 0).
 // The truncated families at the faces perturb theta there (17 % at the face, still 0.6 % at
 // 6 dx inside); the centre of this body, 18 dx inside, is checked to 1e-3.
-TEST(SolidSolver, BodyCoupleAgainstCosseratCoupling) {
+TEST(SolidSolverLong, BodyCoupleAgainstCosseratCoupling) {
   const double dx = 2.5e-3;
   auto g = test::box<2>({40, 40}, 3.015, dx);
   auto disc = discretize(test::world(), g);

@@ -63,7 +63,7 @@ void fix(Body<Dim>& body, std::uint32_t mask, std::function<bool(const double*)>
 // VALIDATION.md section 3: layer 0 <= y <= h, u_x = u(y), theta = theta(y), shear traction tau.
 // The boundary layers (3 rows outside every face) hold the closed form itself, so the interior
 // must relax to it: a layer infinite in x, loaded on its faces.
-TEST(SolidValidation, CosseratLayerSimpleShear) {
+TEST(SolidValidationLong, CosseratLayerSimpleShear) {
   const CosseratShear cs;
   const double mu = cs.mu, mu_c = cs.mu_c, l = cs.l, h = cs.h, lambda = cs.lambda;
   ASSERT_NEAR(cs.alpha(), 163.299, 1e-3);  // the reference number of VALIDATION.md
@@ -345,7 +345,7 @@ ClampedLayer cosserat_layer_between_layers(bool slaved, bool driven, int per_h,
 // (G_eff -0.55 %, measured and reported, not asserted); the consistent distribution is asserted.
 // Constant layers (the paper's method) are measured for the record and must be the worse. The
 // closed form's stiffness ratio is computed here, not copied.
-TEST(SolidValidation, CosseratLayerBetweenSlavedClamps) {
+TEST(SolidValidationLong, CosseratLayerBetweenSlavedClamps) {
   int ranks = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   if (ranks > 1)
