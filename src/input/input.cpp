@@ -707,6 +707,45 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
 void check_region(const ParameterList& c, const ParameterList& regions,
                   const Array<std::string>& faces);
 
+// Boundary Layer Horizons gives floor(value delta / dx) rows per layer (grid_from_input). A value
+// that gives no row leaves the layers and their conditions empty; a layer thicker than both the
+// default 2 horizons and the body it bounds is no boundary layer any more (it is a larger body;
+// points farther than 2 horizons from the face reach neither a body point's family nor those of
+// its neighbours), and a huge value overflows the grid's row counts.
+void check_layer_rows(const ParameterList& d, const Array<std::string>& faces) {
+  const double dx = d.get<double>("Spacing"), h = d.get<double>("Horizon");
+  const double horizon = h > 0 ? h : d.get<double>("Horizon Factor") * dx;
+  const double value = d.get<double>("Boundary Layer Horizons");
+  const double rows = std::floor(value * horizon / dx * (1 + 1e-10));
+  if (rows < 1) {
+    std::ostringstream s;
+    s << "Error, " << path_of(d, "Boundary Layer Horizons") << " = " << value
+      << " gives layers of no row (floor(value * delta / dx) = 0 with delta = " << horizon
+      << " m, dx = " << dx << " m): the boundary layers " << path_of(d, "Boundary Layers")
+      << " asks for and their conditions would be empty. The minimum is dx / delta = "
+      << dx / horizon << " (one row); 2 is usual.";
+    throw InputError(s.str());
+  }
+  const auto counts = d.get<Array<int>>("Counts");
+  const auto ext = d.get<Array<double>>("Extents");
+  const double default_rows = std::floor(2 * horizon / dx * (1 + 1e-10));
+  for (const auto& f : faces) {
+    const int k = f[1] - 'x';
+    const double body = counts.empty() ? std::round(ext[k] / dx) : double(counts[k]);
+    const double most = std::max(default_rows, body);
+    if (rows > most) {
+      std::ostringstream s;
+      s << "Error, " << path_of(d, "Boundary Layer Horizons") << " = " << value
+        << " gives layers of " << rows << " rows, thicker than the body along " << f[1] << " ("
+        << body << " rows) and than the default 2 horizons (" << default_rows
+        << " rows): a boundary layer's points farther than 2 horizons from the face act on no "
+           "point of the body. The maximum here is "
+        << most * dx / horizon << " (2 is usual).";
+      throw InputError(s.str());
+    }
+  }
+}
+
 void check_dimension_arrays(ParameterList& input) {
   ParameterList& d = input.sublist("Discretization");
   const int dim = d.get<int>("Dimension");
@@ -757,6 +796,8 @@ void check_dimension_arrays(ParameterList& input) {
     if (f.size() == 2 && (f[1] - 'x') >= dim)
       throw InputError("Error, " + path_of(d, "Boundary Layers") + " names face " + f +
                        ", which a " + std::to_string(dim) + "D body does not have.");
+  if (!faces.empty())
+    check_layer_rows(d, faces);
   ParameterList& regions = d.sublist("Regions");
   int n_regions = 0;
   for (auto it = regions.begin(); it != regions.end(); ++it, ++n_regions) {
@@ -863,6 +904,14 @@ void check_dimension_arrays(ParameterList& input) {
   const ParameterList& solver = input.sublist("Solver");
   if (!solver.get<Array<double>>("Gravity").empty())
     get_array<double>(solver, "Gravity", dim, "m/s^2");
+  // With Automatic Time Step the run checks it once dt is known (check_run_end).
+  if (!solver.get<bool>("Automatic Time Step")) {
+    const std::string why =
+        end_time_steps_error(solver.get<double>("End Time"), 0, solver.get<double>("Time Step"),
+                             "mupm->Solver->Time Step");
+    if (!why.empty())
+      throw InputError(why);
+  }
   const std::string physics = solver.get<std::string>("Physics");
   const Physics phys = physics_options()(physics);
   const bool fluid = has_fluid(phys);
@@ -923,6 +972,22 @@ void check_dimension_arrays(ParameterList& input) {
                        ": use Automatic or Bulk Matching.");
   }
   const ParameterList& fr = input.sublist("Fracture");
+  // a_min is a film of water in a crack point's cell, whose width is Spacing: its porosity
+  // (a + a_min) / (rows dx) reaches 1 at a_min = dx (one row), beyond which the crack would hold
+  // more water than its cell; the film's stiffness K_w / a_min in the stable step then is
+  // meaningless too (1e308 overflowed to a non-finite aperture, 1e50 ran with nothing moving).
+  {
+    const double amin = fr.get<double>("Minimum Aperture");
+    const double dx = input.sublist("Discretization").get<double>("Spacing");
+    if (!(amin < dx)) {
+      std::ostringstream s;
+      s << "Error, " << path_of(fr, "Minimum Aperture") << " = " << amin
+        << " m is not below the point spacing " << dx
+        << " m (mupm->Discretization->Spacing): the film of water it stands for must fit in a "
+           "crack point's cell (1e-6 m is the default).";
+      throw InputError(s.str());
+    }
+  }
   if (fr.get<bool>("Fracture Flow") && phys != Physics::HydroMechanical)
     throw InputError("Error, " + path_of(fr, "Fracture Flow") +
                      " = true needs Solver->Physics = Hydro-Mechanical (it is " + physics +
@@ -1194,6 +1259,10 @@ void check_files(const Teuchos::Comm<int>& comm, const ParameterList& input) {
       p = p.parent_path();
     if (why.empty() && fs::exists(folder, ec) && !fs::is_directory(folder, ec))
       why = "Error, mupm->Output->Folder = '" + folder + "' is a file, not a folder.";
+    else if (why.empty() && !p.empty() && fs::exists(p, ec) && !fs::is_directory(p, ec))
+      // A component of the path is a file: no folder can be made below it.
+      why = "Error, mupm->Output->Folder = '" + folder + "': '" + p.string() +
+            "' is a file, not a folder.";
     else if (why.empty() && access(p.c_str(), W_OK | X_OK) != 0)
       why = "Error, mupm->Output->Folder = '" + folder + "': '" + p.string() +
             "' is not writable (" + std::strerror(errno) + ").";
@@ -1205,6 +1274,22 @@ void check_files(const Teuchos::Comm<int>& comm, const ParameterList& input) {
     Teuchos::broadcast(comm, 0, static_cast<int>(n), &why[0]);
     throw InputError(why);
   }
+}
+
+std::string end_time_steps_error(double end_time, double time, double dt,
+                                 const std::string& dt_source) {
+  const double steps = (end_time - time) / dt;
+  if (!(end_time > 0) || !(dt > 0) || steps <= kMaxEndTimeSteps)
+    return "";
+  std::ostringstream s;
+  s << "Error, mupm->Solver->End Time = " << end_time << " s takes " << steps
+    << " steps of dt = " << dt << " s (" << dt_source << ")";
+  if (time > 0)
+    s << " from the checkpoint's time " << time << " s";
+  s << ": more than " << kMaxEndTimeSteps
+    << ", which no run reaches (the step counter and the time series are exact below it). "
+       "Check End Time and the time step.";
+  return s.str();
 }
 
 int input_dimension(const ParameterList& input) {

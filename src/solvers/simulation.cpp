@@ -385,6 +385,13 @@ inline void check_run_end(const RunSettings& run, long long step, double time, d
       << " s, which never reaches it. Set Solver->Time Step (with Automatic Time Step = false).";
     throw InputError(s.str());
   }
+  // Also where Automatic Time Step chose dt, and from a checkpoint's time: the step counts of
+  // the progress line and of the run's end must stay meaningful.
+  const std::string why = end_time_steps_error(
+      run.end_time, time, dt,
+      run.automatic_time_step ? "Automatic Time Step's estimate" : "mupm->Solver->Time Step");
+  if (!why.empty())
+    throw InputError(why);
   if (!restarted || !run_ended(run, step, time, dt))
     return;
   std::ostringstream given;

@@ -37,6 +37,15 @@ void validate_input(Teuchos::ParameterList& input);
 
 int input_dimension(const Teuchos::ParameterList& input);
 
+// The most steps Solver->End Time may ask for: the step counter is a long long (9.2e18) but the
+// time series writes it as a double (exact to 2^53 = 9e15), and 1e12 steps are beyond any run
+// (a month at 4e5 steps per second); more is a mistaken End Time or Time Step.
+inline constexpr double kMaxEndTimeSteps = 1e12;
+// The message for End Time over Time Step beyond kMaxEndTimeSteps ("" when within), `dt_source`
+// naming where dt comes from.
+std::string end_time_steps_error(double end_time, double time, double dt,
+                                 const std::string& dt_source);
+
 template <int Dim>
 GridSpec<Dim> grid_from_input(const Teuchos::ParameterList& input);
 

@@ -161,8 +161,13 @@ class FractureFlow {
     const int n = int(gid_.size());
     last_size_ = n;
     Kokkos::deep_copy(sink, 0.0);
-    if (n == 0)
+    if (n == 0) {
+      // No fracture point anywhere (yet): a Fracture Source has nowhere to put its water.
+      for (const auto& bc : bcs_)
+        if (bc.kind == BoundaryCondition::FractureSource)
+          check_source(bc, t, 0.0);
       return;
+    }
     assemble(t, dt);
     solve();
     scatter(dt, sink);
@@ -269,10 +274,21 @@ class FractureFlow {
 
   // The system of the header, in global-id order: CSR adjacency, conductances, diagonal,
   // right-hand side; prescribed p_f and the sources at t + dt / t.
+  // A Fracture Source's rate q [m^3/s] at t; an error when it injects (q != 0) but its region
+  // holds no fracture point (volume vsum) on the gathered network, the same on every rank.
+  double check_source(const BoundaryCondition& bc, double t, double vsum) const {
+    const double h = Dim == 2 ? disc_.grid.thickness : 1.0;
+    const double q = bc.value * bc.time(t) * h;
+    if (q != 0 && !(vsum > 0))
+      throw CollectiveError("Error, mupm->Boundary Conditions->" + bc.name +
+                            " (Fracture Source) has no fracture point in its region at t = " +
+                            std::to_string(t) + " s: put the region on the crack.");
+    return q;
+  }
+
   void assemble(double t, double dt) {
     const int n = int(gid_.size());
     const double dx = disc_.grid.dx;
-    const double h = Dim == 2 ? disc_.grid.thickness : 1.0;
     const double mu = prm_.viscosity, amin = prm_.min_aperture;
     const double inv_kw = 1.0 / fluid_.bulk_modulus;
     const VanGenuchten vg = fluid_.retention;
@@ -368,11 +384,7 @@ class FractureFlow {
         for (int i = 0; i < n; ++i)
           if (in(i))
             vsum += r(i, kVol);
-        const double q = bc.value * bc.time(t) * h;
-        if (q != 0 && !(vsum > 0))
-          throw CollectiveError("Error, boundary condition '" + bc.name +
-                                "' (Fracture Source) has no fracture point in its region at t = " +
-                                std::to_string(t) + " s: put the region on the crack.");
+        const double q = check_source(bc, t, vsum);
         for (int i = 0; i < n; ++i)
           if (in(i))
             source_[i] += q * r(i, kVol) / vsum;
