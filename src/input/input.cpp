@@ -215,7 +215,9 @@ RCP<ParameterList> valid_parameters() {
     d.set("Boundary Layer Horizons", 2.0,
           "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
           "default) gives the layer points next to the body full families too, which the "
-          "correspondence model needs for exact boundary values; the paper's layers are 1.",
+          "correspondence model needs for exact boundary values; the paper's layers are 1. With "
+          "Boundary Layers: at least dx / delta (one row), and at most the larger of the body "
+          "along the layer's axis and 2 horizons.",
           positive());
     d.set("Boundary Layers", Array<std::string>(),
           "Faces of the body that get a boundary layer of fictitious points outside them (the "
@@ -381,7 +383,8 @@ RCP<ParameterList> valid_parameters() {
           "a_min [m]: a film of water in the crack (the paper gives none). The conductance "
           "takes max(a, a_min); the storage the crack's volume a + a_min, whose opening stores "
           "water. The crack water's stiffness K_w / a_min enters the solid's stable step: a "
-          "small a_min (with a stiff water) means a small step.",
+          "small a_min (with a stiff water) means a small step. Below Spacing (the film fits in a "
+          "crack point's cell).",
           positive());
   }
   {
@@ -486,7 +489,7 @@ RCP<ParameterList> valid_parameters() {
           "Simulated time to run to [s]; > 0: the run ends on the first step whose time reaches "
           "it (within 1e-6 dt), ceil(End Time / dt) steps with the dt in use (Automatic Time "
           "Step's estimate, or Time Step; a restart may take another), and Number of Steps is "
-          "not used; 0: run Number of Steps.",
+          "not used; 0: run Number of Steps. More than 1e12 steps is refused.",
           at_least(0.0));
     s.set("Restart From", std::string(""),
           "Checkpoint file (.h5) to continue from; empty: start at t = 0. The run may use a "
