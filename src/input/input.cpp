@@ -383,7 +383,8 @@ RCP<ParameterList> valid_parameters() {
           "a_min [m]: a film of water in the crack (the paper gives none). The conductance "
           "takes max(a, a_min); the storage the crack's volume a + a_min, whose opening stores "
           "water. The crack water's stiffness K_w / a_min enters the solid's stable step: a "
-          "small a_min (with a stiff water) means a small step. Below Spacing (the film fits in a "
+          "small a_min (with a stiff water) means a small step. With Fracture Flow, below Spacing "
+          "(the film fits in a "
           "crack point's cell).",
           positive());
   }
@@ -979,7 +980,8 @@ void check_dimension_arrays(ParameterList& input) {
   // (a + a_min) / (rows dx) reaches 1 at a_min = dx (one row), beyond which the crack would hold
   // more water than its cell; the film's stiffness K_w / a_min in the stable step then is
   // meaningless too (1e308 overflowed to a non-finite aperture, 1e50 ran with nothing moving).
-  {
+  // Only the crack water uses it.
+  if (fr.get<bool>("Fracture Flow")) {
     const double amin = fr.get<double>("Minimum Aperture");
     const double dx = input.sublist("Discretization").get<double>("Spacing");
     if (!(amin < dx)) {
