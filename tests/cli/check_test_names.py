@@ -53,14 +53,18 @@ def main():
             selectors.append((patterns(kind, suite), source))
     listing = subprocess.run([binary, "--gtest_list_tests"], capture_output=True, text=True,
                              check=True).stdout
+    # "Suite." or "Prefix/Suite." or "Suite/0." (then "  # TypeParam = ..."), then "  Test" or
+    # "  Test/0" lines; anything else (a library's warning on stdout) is not the listing.
+    suite_line = re.compile(r"^([A-Za-z0-9_]+(?:/[A-Za-z0-9_]+)*\.)(?:\s+#.*)?$")
+    test_line = re.compile(r"^  ([A-Za-z0-9_]+(?:/[A-Za-z0-9_]+)*)(?:\s+#.*)?$")
     suite, count = None, 0
     for line in listing.splitlines():
-        if not line.strip():
+        if suite_line.match(line):
+            suite = suite_line.match(line).group(1)
             continue
-        if not line.startswith(" "):
-            suite = line.split()[0]  # "Suite." or "Prefix/Suite." or "Suite/0."
+        if not test_line.match(line) or suite is None:
             continue
-        test = suite + line.split()[0]
+        test = suite + test_line.match(line).group(1)
         count += 1
         where = {src for pattern, src in selectors if fnmatch.fnmatchcase(test, pattern)}
         if len(where) != 1:

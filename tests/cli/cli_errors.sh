@@ -313,8 +313,8 @@ run 2 1 resume.xml >resume.out 2>&1 || { cat resume.out; fail "sigterm: the rest
 rows=$(tail -n +2 long/time_series.csv | cut -d, -f1 | sort -n | uniq -d | wc -l)
 [[ $rows == 0 ]] || fail "sigterm: time_series.csv repeats $rows step(s)"
 echo "ok: sigterm (exit 4 at step $stopped, resumed)"
-# Issue 34, garbage that once ran with exit 0 (or on without end): refused by name, by the run and
-# by --validate.
+# Inputs that once ran with exit 0 and wrong results (or without end): refused by name, by the
+# run and by --validate.
 # Boundary Layer Horizons: floor(value * delta / dx) rows; 0.1 gave no row (conditions on the
 # layers did nothing), 1e9 overflowed the row count (0 points, "needs about -nan MiB").
 layer_hold() {  # a Displacement on 'Layer +y' appended to the input on stdin
