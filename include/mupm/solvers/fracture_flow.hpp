@@ -272,8 +272,6 @@ class FractureFlow {
   }
   double r(int k, int slot) const { return rec_[std::size_t(k) * kRecord + slot]; }
 
-  // The system of the header, in global-id order: CSR adjacency, conductances, diagonal,
-  // right-hand side; prescribed p_f and the sources at t + dt / t.
   // A Fracture Source's rate q [m^3/s] at t; an error when it injects (q != 0) but its region
   // holds no fracture point (volume vsum) on the gathered network, the same on every rank.
   double check_source(const BoundaryCondition& bc, double t, double vsum) const {
@@ -286,6 +284,8 @@ class FractureFlow {
     return q;
   }
 
+  // The system of the header, in global-id order: CSR adjacency, conductances, diagonal,
+  // right-hand side; prescribed p_f and the sources at t + dt / t.
   void assemble(double t, double dt) {
     const int n = int(gid_.size());
     const double dx = disc_.grid.dx;
