@@ -711,16 +711,25 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
 void check_region(const ParameterList& c, const ParameterList& regions,
                   const Array<std::string>& faces);
 
+// The horizon delta [m] of Discretization: Horizon, or Horizon Factor times Spacing.
+double horizon_of(const ParameterList& d) {
+  const double h = d.get<double>("Horizon");
+  return h > 0 ? h : d.get<double>("Horizon Factor") * d.get<double>("Spacing");
+}
+// Rows of a boundary layer `horizons` horizons thick: floor(horizons delta / dx) (grid_from_input).
+double layer_rows(const ParameterList& d, double horizons) {
+  return std::floor(horizons * horizon_of(d) / d.get<double>("Spacing") * (1 + 1e-10));
+}
+
 // Boundary Layer Horizons gives floor(value delta / dx) rows per layer (grid_from_input). A value
 // that gives no row leaves the layers and their conditions empty; a layer thicker than both the
 // default 2 horizons and the body it bounds is no boundary layer any more (it is a larger body;
 // points farther than 2 horizons from the face reach neither a body point's family nor those of
 // its neighbours), and a huge value overflows the grid's row counts.
 void check_layer_rows(const ParameterList& d, const Array<std::string>& faces) {
-  const double dx = d.get<double>("Spacing"), h = d.get<double>("Horizon");
-  const double horizon = h > 0 ? h : d.get<double>("Horizon Factor") * dx;
+  const double dx = d.get<double>("Spacing"), horizon = horizon_of(d);
   const double value = d.get<double>("Boundary Layer Horizons");
-  const double rows = std::floor(value * horizon / dx * (1 + 1e-10));
+  const double rows = layer_rows(d, value);
   if (rows < 1) {
     std::ostringstream s;
     s << "Error, " << path_of(d, "Boundary Layer Horizons") << " = " << value
@@ -732,7 +741,7 @@ void check_layer_rows(const ParameterList& d, const Array<std::string>& faces) {
   }
   const auto counts = d.get<Array<int>>("Counts");
   const auto ext = d.get<Array<double>>("Extents");
-  const double default_rows = std::floor(2 * horizon / dx * (1 + 1e-10));
+  const double default_rows = layer_rows(d, 2);
   for (const auto& f : faces) {
     const int k = f[1] - 'x';
     const double body = counts.empty() ? std::round(ext[k] / dx) : double(counts[k]);
@@ -784,7 +793,7 @@ void check_dimension_arrays(ParameterList& input) {
   {
     const double dx = d.get<double>("Spacing"), h = d.get<double>("Horizon");
     const bool given = h > 0;
-    const double horizon = given ? h : d.get<double>("Horizon Factor") * dx;
+    const double horizon = horizon_of(d);
     if (horizon < dx * (1 - 1e-9)) {
       std::ostringstream s;
       s << "Error, " << path_of(d, given ? "Horizon" : "Horizon Factor") << " = "
@@ -1306,8 +1315,7 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
   const ParameterList& d = input.sublist("Discretization");
   GridSpec<Dim> g;
   g.dx = d.get<double>("Spacing");
-  const double h = d.get<double>("Horizon");
-  g.horizon = h > 0 ? h : d.get<double>("Horizon Factor") * g.dx;
+  g.horizon = horizon_of(d);
   g.thickness = Dim == 2 ? d.get<double>("Thickness") : 1.0;
   const auto counts = d.get<Array<int>>("Counts");
   const auto ext = d.get<Array<double>>("Extents");
@@ -1316,8 +1324,8 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
     g.counts[k] = counts.empty() ? std::llround(ext[k] / g.dx) : counts[k];
     g.origin[k] = origin.empty() ? 0.0 : origin[k];
   }
-  const int rows =
-      static_cast<int>(d.get<double>("Boundary Layer Horizons") * g.horizon / g.dx * (1 + 1e-10));
+  // check_layer_rows has bounded it.
+  const int rows = static_cast<int>(layer_rows(d, d.get<double>("Boundary Layer Horizons")));
   for (const auto& f : d.get<Array<std::string>>("Boundary Layers"))
     g.layers[f[1] - 'x'][f[0] == '-' ? 0 : 1] = rows;
   const ParameterList& regions = d.sublist("Regions");
