@@ -10,6 +10,7 @@
 
 #include "mupm/core/stop.hpp"
 #include "mupm/input/input.hpp"
+#include "mupm/input/model.hpp"
 #include "mupm/io/checkpoint.hpp"
 #include "mupm/io/point_rows.hpp"
 #include "mupm/solvers/simulation.hpp"
@@ -42,7 +43,8 @@ void check_restart_file(const Teuchos::Comm<int>& comm, const Teuchos::Parameter
     n = g.n_global(), dx = g.dx, horizon = g.horizon;
   }
   try {
-    mupm::check_checkpoint(mupm::io::raw(comm), path, dim, n, dx, horizon);
+    mupm::check_checkpoint(mupm::io::raw(comm), path, dim, n, dx, horizon,
+                           mupm::fixed_settings(input));
   } catch (const mupm::CollectiveError& e) {
     throw mupm::InputError(mupm::restart_from_error(path, e));
   }

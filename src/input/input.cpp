@@ -91,14 +91,17 @@ void crack_template(ParameterList& c) {
         "3D: second edge vector of the rectangle from Corner [m], orthogonal to Edge 1.");
 }
 void ic_template(ParameterList& c) {
-  c.set("Field", std::string("Velocity"),
-        "Field to set: " + joined(ic_fields()) +
-            ". Value holds one entry per component: Displacement, Velocity: Dim; Micro-Rotation, "
-            "Micro-Rotation Rate: 1 in 2D, 3 in 3D; Pore Pressure, Fracture Pressure [Pa], "
-            "Porosity, Saturation: 1 (with a fluid physics S_r follows from the pressure "
-            "instead). Hydrostatic Pore Pressure: p = rho_w g . (x - x_0) with g = "
-            "Solver->Gravity and Value = x_0, a point of the water table (Dim values).",
-        one_of(ic_fields()));
+  c.set(
+      "Field", std::string("Velocity"),
+      "Field to set: " + joined(ic_fields()) +
+          ". Value holds one entry per component: Displacement, Velocity: Dim; Micro-Rotation, "
+          "Micro-Rotation Rate: 1 in 2D, 3 in 3D; Pore Pressure [Pa], "
+          "Porosity, Saturation: 1 (with a fluid physics S_r follows from the pressure "
+          "instead). The crack water takes none: a point joins the fracture network with "
+          "its pore pressure (a pre-crack's points at the first step), so a Pore Pressure on "
+          "the crack's region sets it. Hydrostatic Pore Pressure: p = rho_w g . (x - x_0) with g = "
+          "Solver->Gravity and Value = x_0, a point of the water table (Dim values).",
+      one_of(ic_fields()));
   c.set("Region", std::string("All"),
         "Name of a region of Discretization->Regions, or All. Later conditions overwrite "
         "earlier ones where they overlap.");
@@ -699,6 +702,28 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
                          " has a half size of " + std::to_string(v * unit) +
                          " m, below one Spacing (" + std::to_string(dx) +
                          " m): a contour must hold the tip and the points around it.");
+  // The contours at the start, centred on the first pre-crack's End, inside the real body (their
+  // edges go to the nearest cell faces, at most dx/2 away): a contour beyond it runs through no
+  // material, and J came out 0.012 for 0.93 with a half width past the body's faces.
+  const ParameterList& cracks = d.sublist("Pre-Cracks");
+  const auto tip = cracks.sublist(cracks.name(cracks.begin())).get<Array<double>>("End");
+  const auto counts = d.get<Array<int>>("Counts");
+  const auto ext = d.get<Array<double>>("Extents");
+  const auto origin = d.get<Array<double>>("Origin");
+  for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
+    for (int a = 0; a < 2; ++a) {
+      const double o = origin.empty() ? 0.0 : origin[a];
+      const double n = counts.empty() ? std::round(ext[a] / dx) : double(counts[a]);
+      const double half = (a == 0 ? w[k] : h[k]) * unit;
+      if (tip[a] - half < o - 0.5 * dx || tip[a] + half > o + n * dx + 0.5 * dx) {
+        std::ostringstream m;
+        m << "Error, " << (a == 0 ? what : path_of(j, "Half Heights")) << ": contour " << k + 1
+          << " spans " << (a == 0 ? 'x' : 'y') << " = " << tip[a] - half << " to " << tip[a] + half
+          << " m around the first pre-crack's End, beyond the body (" << o << " to " << o + n * dx
+          << " m): the contour must run through the material. Give a smaller half size.";
+        throw InputError(m.str());
+      }
+    }
   const double inc = j.get<double>("Crack Increment");
   for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
     if (criterion && std::min(w[k], h[k]) * unit < inc)
@@ -1377,6 +1402,18 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
         cr.c[k] = e2[k];
       }
     }
+    // A crack that misses the body breaks no bond and would measure no length.
+    Box body;
+    for (int k = 0; k < Dim; ++k) {
+      body.lo[k] = g.origin[k];
+      body.hi[k] = g.origin[k] + double(g.counts[k]) * g.dx;
+    }
+    const CrackPart part = crack_inside<Dim>(cr, body);
+    if (!(part.s1 > part.s0))
+      throw InputError("Error, " + c.name() +
+                       " lies outside the body (or touches it in a point or along its surface "
+                       "only): it would cut no bond. Check its coordinates against the body, "
+                       "which spans Origin to Origin + Counts x Spacing.");
     g.cracks.push_back(cr);
   }
   return g;

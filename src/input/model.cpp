@@ -4,11 +4,61 @@
 
 #include <Teuchos_Array.hpp>
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
 
 namespace mupm {
 
 using Teuchos::Array;
 using Teuchos::ParameterList;
+
+namespace {
+
+// The shortest text of x that reads back as x exactly (a change in the last bit is a change).
+std::string exact(double x) {
+  char buf[32];
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    if (std::strtod(buf, nullptr) == x)
+      break;
+  }
+  return buf;
+}
+
+// A value as text that tells any two values apart.
+std::string exact_text(const Teuchos::ParameterEntry& e) {
+  std::ostringstream s;
+  if (e.isType<double>()) {
+    s << exact(Teuchos::getValue<double>(e));
+  } else if (e.isType<Array<double>>()) {
+    const auto a = Teuchos::getValue<Array<double>>(e);
+    s << "{";
+    for (Teuchos::Ordinal k = 0; k < a.size(); ++k)
+      s << (k ? ", " : "") << exact(a[k]);
+    s << "}";
+  } else if (e.isType<bool>()) {
+    s << (Teuchos::getValue<bool>(e) ? "true" : "false");
+  } else {
+    e.getAny(false).print(s);
+  }
+  return s.str();
+}
+
+// The pre-cracks as text: each sublist's name and its non-empty geometry, in input order.
+std::string cracks_text(const ParameterList& cracks) {
+  std::string s;
+  for (auto it = cracks.begin(); it != cracks.end(); ++it) {
+    const ParameterList& c = cracks.sublist(cracks.name(it));
+    s += (s.empty() ? "" : "; ") + cracks.name(it) + ":";
+    for (const char* k : {"Start", "End", "Corner", "Edge 1", "Edge 2"})
+      if (!c.get<Array<double>>(k).empty())
+        s += std::string(" ") + k + " = " + exact_text(c.getEntry(k));
+  }
+  return s.empty() ? "none" : s;
+}
+
+}  // namespace
 
 const Options<Physics>& physics_options() {
   static const Options<Physics> o("Physics", {{"Micropolar Solid", Physics::MicropolarSolid},
@@ -328,6 +378,17 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.plasticity.cohesion = materials.get<double>("Cohesion");
   m.plasticity.residual = materials.get<double>("Residual Cohesion");
   m.plasticity.softening = materials.get<double>("Softening Modulus");
+  // psi > phi: the plastic dissipation per d lambda, q + sqrt3 a3 p-bar = k c + sqrt3 (a3 - a1)
+  // p-bar on the yield surface (include/mupm/laws/micropolar_drucker_prager.hpp), turns negative
+  // under a mean compression -p-bar beyond k c / (sqrt3 (a3 - a1)).
+  if (m.constitutive_model == ConstitutiveModel::MicropolarDruckerPrager &&
+      m.plasticity.dilation > m.plasticity.friction)
+    m.warnings.push_back(
+        "mupm->Materials->Dilation Angle = " + exact(materials.get<double>("Dilation Angle")) +
+        " exceeds Friction Angle = " + exact(materials.get<double>("Friction Angle")) +
+        " degrees: the plastic dissipation turns negative (energy made by plastic flow) under "
+        "a mean compressive stress beyond k c / (sqrt3 (a3 - a1)) (eqs 87-91); soils have psi "
+        "<= phi");
   m.solid_density = materials.get<double>("Solid Density");
   m.porosity = materials.get<double>("Porosity");
 
@@ -397,7 +458,42 @@ Model<Dim> model_from_input(const ParameterList& input) {
   check_fluid_flux(m.grid, m.boundary_conditions, input.name());
   check_consistent_traction(m.grid, m.boundary_conditions, input.name());
   m.initial_conditions = initial_conditions_from_input(input);
+  r.fixed = fixed_settings(input);
   return m;
+}
+
+FixedSettings fixed_settings(const ParameterList& input) {
+  const ParameterList& solver = input.sublist("Solver");
+  const ParameterList& fracture = input.sublist("Fracture");
+  const Physics physics = physics_options()(solver.get<std::string>("Physics"));
+  FixedSettings f;
+  auto fix = [&](const char* list, const std::string& name, const std::string& why) {
+    f.push_back(
+        {std::string(list) + "->" + name, exact_text(input.sublist(list).getEntry(name)), why});
+  };
+  fix("Solver", "Physics", "the checkpoint's state holds that physics' fields and balances only");
+  if (has_solid(physics)) {
+    fix("Materials", "Model",
+        "a Drucker-Prager state (plastic strains, softened cohesion, plastic dissipation) can "
+        "neither be dropped nor made up without a jump in the stored energy");
+    fix("Fracture", "Bond Breakage",
+        "each criterion keeps its own state (bond energies, the crack's tip), which the other "
+        "has not accumulated");
+  }
+  const ParameterList& d = input.sublist("Discretization");
+  f.push_back({"Discretization->Pre-Cracks", cracks_text(d.sublist("Pre-Cracks")),
+               "the broken bonds and fracture points come from the checkpoint; a pre-crack "
+               "added or moved would break loaded bonds without their energy being booked"});
+  if (physics == Physics::HydroMechanical) {
+    fix("Fracture", "Fracture Flow",
+        "the crack water (its pressure and mass) would appear or vanish, breaking the water "
+        "balance");
+    if (fracture.get<bool>("Fracture Flow"))
+      fix("Fracture", "Minimum Aperture",
+          "the crack's stored water (a + a_min) and its stiffness, from which the run's stable "
+          "step was estimated, are the checkpoint's");
+  }
+  return f;
 }
 
 template Model<2> model_from_input<2>(const ParameterList&);

@@ -119,8 +119,12 @@ void for_each_checkpointed(Registry& r, F&& f) {
 
 namespace {
 
+std::string fixed_attribute(const FixedSetting& f) {
+  return "input " + f.path;
+}
+
 void check_header(const io::PointFile& file, const std::string& path, int dim, long long n_global,
-                  double dx, double horizon) {
+                  double dx, double horizon, const FixedSettings& fixed) {
   const std::string where = "Error, the checkpoint '" + path + "' ";
   const long long version = file.has_attribute("mupm_checkpoint_version")
                                 ? file.read_attribute_int("mupm_checkpoint_version")
@@ -149,14 +153,24 @@ void check_header(const io::PointFile& file, const std::string& path, int dim, l
              std::to_string(file.read_attribute_double("spacing")) + "/" +
                  std::to_string(file.read_attribute_double("horizon")),
              std::to_string(dx) + "/" + std::to_string(horizon));
+  for (const auto& f : fixed) {
+    const std::string name = fixed_attribute(f);
+    if (!file.has_attribute(name))
+      continue;
+    const std::string there = file.read_attribute_string(name);
+    if (there != f.value)
+      throw CollectiveError(where + "was written with mupm->" + f.path + " = " + there +
+                            ", and this input has " + f.value + ": " + f.why +
+                            ". Restart with the checkpoint's value, or start the run again.");
+  }
 }
 
 }  // namespace
 
 void check_checkpoint(MPI_Comm comm, const std::string& path, int dim, long long n_global,
-                      double dx, double horizon) {
+                      double dx, double horizon, const FixedSettings& fixed) {
   auto file = io::PointFile::open(comm, path);
-  check_header(file, path, dim, n_global, dx, horizon);
+  check_header(file, path, dim, n_global, dx, horizon, fixed);
 }
 
 std::string restart_from_error(const std::string& path, const std::exception& e) {
@@ -169,7 +183,7 @@ std::string restart_from_error(const std::string& path, const std::exception& e)
 template <int Dim>
 void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, long long step,
                       double time, const std::vector<double>& output_history,
-                      const NamedGlobals& globals) {
+                      const NamedGlobals& globals, const FixedSettings& fixed) {
   ScopedRegion region("mupm::Output::checkpoint");
   const MPI_Comm comm = io::raw(*disc.dist.comm());
   const std::size_t n = disc.points.n_owned;
@@ -185,6 +199,8 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
     file.write_attribute("time", time);
     file.write_attribute("spacing", disc.grid.dx);
     file.write_attribute("horizon", disc.grid.horizon);
+    for (const auto& f : fixed)
+      file.write_attribute(fixed_attribute(f), f.value);
     file.write_global("output_history", output_history);
     for (const auto& [name, value] : globals)
       file.write_global("globals/" + name, {*value});
@@ -211,15 +227,15 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
 
 template <int Dim>
 void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long long& step,
-                     double& time, std::vector<double>& output_history,
-                     const NamedGlobals& globals) {
+                     double& time, std::vector<double>& output_history, const NamedGlobals& globals,
+                     const FixedSettings& fixed) {
   ScopedRegion region("mupm::Output::restart");
   const MPI_Comm comm = io::raw(*disc.dist.comm());
   const std::size_t n = disc.points.n_owned;
   const auto gids = io::owned_rows(disc.points.gid, n);
   auto file = io::PointFile::open(comm, path);
   const std::string where = "Error, the checkpoint '" + path + "' ";
-  check_header(file, path, Dim, disc.dist.n_global(), disc.grid.dx, disc.grid.horizon);
+  check_header(file, path, Dim, disc.dist.n_global(), disc.grid.dx, disc.grid.horizon, fixed);
   step = file.read_attribute_int("step");
   time = file.read_attribute_double("time");
   output_history = file.read_global("output_history");
@@ -256,9 +272,11 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
 
 #define MUPM_INSTANTIATE(D)                                                                     \
   template void write_checkpoint<D>(const std::string&, const Discretization<D>&, long long,    \
-                                    double, const std::vector<double>&, const NamedGlobals&);   \
+                                    double, const std::vector<double>&, const NamedGlobals&,    \
+                                    const FixedSettings&);                                      \
   template void read_checkpoint<D>(const std::string&, Discretization<D>&, long long&, double&, \
-                                   std::vector<double>&, const NamedGlobals&);
+                                   std::vector<double>&, const NamedGlobals&,                   \
+                                   const FixedSettings&);
 MUPM_INSTANTIATE(2)
 MUPM_INSTANTIATE(3)
 #undef MUPM_INSTANTIATE

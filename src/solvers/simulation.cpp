@@ -1,6 +1,8 @@
 #include "mupm/solvers/simulation.hpp"
 
+#include <fcntl.h>
 #include <sched.h>
+#include <sys/file.h>
 #include <unistd.h>
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
@@ -10,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -58,33 +61,101 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Creates the output folder and writes the resolved input there, before the heavy work, so a
-// bad folder fails early.
+// The output folder's lock, held by rank 0 for the whole run: two runs writing one folder would
+// interleave their time series and leave one's input beside the other's checkpoint. An advisory
+// flock() on Output->Folder/run.lock, which the kernel releases when the process ends however it
+// ends (a crash or SIGKILL leaves no stale lock; the file itself stays). The file holds the
+// holder's process id and host for the message of a run refused.
+class FolderLock {
+ public:
+  FolderLock() = default;
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+  ~FolderLock() {
+    if (fd_ >= 0)
+      close(fd_);  // releases the lock
+  }
+  // "" when taken, else why not.
+  std::string take(const std::string& folder) {
+    const std::string path = folder + "/run.lock";
+    fd_ = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0)
+      return "cannot open " + path + ": " + std::strerror(errno);
+    if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      char holder[256] = {};
+      const ssize_t n = pread(fd_, holder, sizeof holder - 1, 0);
+      std::string who = n > 0 ? std::string(holder, std::size_t(n)) : "";
+      while (!who.empty() && (who.back() == '\n' || who.back() == ' '))
+        who.pop_back();
+      close(fd_);
+      fd_ = -1;
+      if (err != EWOULDBLOCK) {
+        // A file system without locks (Lustre mounted without -o flock): run unguarded.
+        unguarded_ = "mupm: WARNING: cannot lock " + path + " (" + std::strerror(err) +
+                     "): nothing stops a second run from writing into this folder meanwhile.\n";
+        return "";
+      }
+      return "another mupm run is writing it (" + (who.empty() ? "holder unknown" : who) +
+             "; lock file " + path +
+             "): two runs in one folder would mix their time series, fields and checkpoints. "
+             "Wait for that run to end, or give this one another Output->Folder";
+    }
+    char host[256] = {};
+    gethostname(host, sizeof host - 1);
+    const std::string me = "process " + std::to_string(getpid()) + " on host " + host + "\n";
+    if (ftruncate(fd_, 0) != 0 || pwrite(fd_, me.data(), me.size(), 0) < 0) {
+      // The lock holds without the note; only the message of a refused run loses the holder.
+    }
+    return "";
+  }
+  // Why the folder is not locked although take() succeeded ("" when it is).
+  const std::string& unguarded() const { return unguarded_; }
+
+ private:
+  int fd_ = -1;
+  std::string unguarded_;
+};
+
+// Creates the output folder, locks it (FolderLock, on rank 0) and writes the resolved input
+// there, before the heavy work, so a bad or busy folder fails early.
 void prepare_folder(const Teuchos::Comm<int>& comm, const std::string& folder,
-                    const Teuchos::ParameterList& input) {
-  int ok = 1;
+                    const Teuchos::ParameterList& input, FolderLock& lock, std::ostream& out) {
+  int ok = 1;  // 0: cannot write, -1: in use
   std::string why;
   if (comm.getRank() == 0) {
     std::error_code ec;
     std::filesystem::create_directories(folder, ec);
     if (ec) {
       ok = 0;
-      why = ec.message();
+      why = "cannot write to it: " + ec.message();
+    } else if (const std::string busy = lock.take(folder); !busy.empty()) {
+      ok = -1;
+      why = busy;
     } else {
+      out << lock.unguarded();
       // A checkpoint being written when an earlier run was killed.
       std::filesystem::remove(folder + "/checkpoint.h5.tmp", ec);
       try {
         Teuchos::writeParameterListToXmlFile(input, folder + "/input_resolved.xml");
       } catch (const std::exception& e) {
         ok = 0;
-        why = e.what();
+        why = std::string("cannot write to it: ") + e.what();
       }
     }
   }
   Teuchos::broadcast(comm, 0, &ok);
-  if (!ok)
-    throw CollectiveError("Error, cannot write to the output folder '" + folder +
-                          "' (Output->Folder)" + (why.empty() ? "" : ": " + why));
+  if (ok == 1)
+    return;
+  long long n = static_cast<long long>(why.size());
+  Teuchos::broadcast(comm, 0, &n);
+  why.resize(static_cast<std::size_t>(n));
+  if (n > 0)
+    Teuchos::broadcast(comm, 0, static_cast<int>(n), &why[0]);
+  const std::string msg = "Error, mupm->Output->Folder = '" + folder + "': " + why + ".";
+  if (ok < 0)
+    throw InputError(msg);  // the folder is in use: exit 2, like a folder that is a file
+  throw CollectiveError(msg);
 }
 
 // The largest global id of an owned point whose registry fields marked kFinite (the primary
@@ -354,7 +425,7 @@ template <int Dim>
 void restart(const RunSettings& run, Discretization<Dim>& disc, long long& step, double& time,
              std::vector<double>& history, const NamedGlobals& globals) {
   try {
-    read_checkpoint(run.restart_from, disc, step, time, history, globals);
+    read_checkpoint(run.restart_from, disc, step, time, history, globals, run.fixed);
   } catch (const CollectiveError& e) {
     throw InputError(restart_from_error(run.restart_from, e));
   }
@@ -749,7 +820,11 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   const Model<Dim> model = model_from_input<Dim>(input);
   const RunSettings& run = model.run;
   const bool timers_on = run.kernel_timers && timers::enable();
-  prepare_folder(*comm, run.folder, input);
+  FolderLock lock;
+  prepare_folder(*comm, run.folder, input, lock, out);
+  for (const auto& w : model.warnings)
+    if (rank == 0)
+      out << "mupm: WARNING: " << w << ".\n";
   warn_placement(mpi, int(ExecSpace().concurrency()), out);
 
   Discretization<Dim> disc = discretize(comm, model.grid);
@@ -804,7 +879,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   };
   const std::string checkpoint_path = run.folder + "/checkpoint.h5";
   auto checkpoint = [&] {
-    write_checkpoint(checkpoint_path, disc, step, time, fields.history(), ph.globals());
+    write_checkpoint(checkpoint_path, disc, step, time, fields.history(), ph.globals(), run.fixed);
   };
   if (!restarted) {
     fields.write(step, time);

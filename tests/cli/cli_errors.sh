@@ -2,47 +2,7 @@
 # Each class of input error stops both ranks with exit code 2 and a message naming the
 # parameter's full path; none hangs (each run has a time limit) or crashes.
 source "$(dirname "$0")/common.sh"
-# A rank that exits non-zero makes mpirun end the others, which it does after
-# odls_base_sigkill_timeout (1 s by default: each refused input then took 2.4 s instead of 0.4 s);
-# here every rank stops with the same error. The SIGTERM test keeps the default.
-export OMPI_MCA_odls_base_sigkill_timeout=0
-
-base() {  # base DISCRETIZATION_EXTRA SOLVER_EXTRA
-  cat <<XML
-<ParameterList name="mupm">
-  <ParameterList name="Discretization">
-    <Parameter name="Spacing" type="double" value="0.01"/>
-    <Parameter name="Counts" type="Array(int)" value="{20, 10}"/>
-    $1
-  </ParameterList>
-  <ParameterList name="Materials">
-    <Parameter name="Bulk Modulus" type="double" value="1e8"/>
-    <Parameter name="Shear Modulus" type="double" value="5e7"/>
-    <Parameter name="Length Scale" type="double" value="1e-3"/>
-  </ParameterList>
-  <ParameterList name="Solver">
-    <Parameter name="Number of Steps" type="int" value="2"/>
-    $2
-  </ParameterList>
-  <ParameterList name="Output"><Parameter name="Folder" type="string" value="out"/></ParameterList>
-</ParameterList>
-XML
-}
-
-expect() {  # expect NAME CODE PATTERN... (input in NAME.xml)
-  local name=$1 code=$2
-  shift 2
-  set +e
-  run 2 1 "$name.xml" >"$name.out" 2>&1
-  local got=$?
-  set -e
-  [[ $got == 124 ]] && fail "$name: timed out (hang)"
-  [[ $got == "$code" ]] || { cat "$name.out"; fail "$name: exit code $got, expected $code"; }
-  for p in "$@"; do
-    grep -qF -- "$p" "$name.out" || { cat "$name.out"; fail "$name: message lacks '$p'"; }
-  done
-  echo "ok: $name (exit $got)"
-}
+source "$(dirname "$0")/error_cases.sh"
 
 base '<Parameter name="Spacingg" type="double" value="1"/>' '' >unknown.xml
 expect unknown 2 'Spacingg' 'mupm->Discretization' 'valid parameters'
@@ -130,17 +90,6 @@ grep -q "MPI_ABORT" no_checkpoint.out && fail "no_checkpoint: aborted instead of
 # Files the input names are checked before any work, in one line each, by the run and by
 # --validate: a directory as the input or as the restart file, a file that is not HDF5.
 mkdir -p adir
-expect_dir() {  # expect_dir NAME PATTERN ARGS...: exit 2 and one line of error
-  local name=$1 pattern=$2
-  shift 2
-  set +e
-  run 2 1 "$@" >"$name.out" 2>"$name.err"
-  local got=$?
-  set -e
-  [[ $got == 2 ]] && grep -qF -- "$pattern" "$name.err" || { cat "$name.err"; fail "$name: exit $got"; }
-  grep -q "HDF5-DIAG\|MPI_ERR\|packages/" "$name.err" && { cat "$name.err"; fail "$name: library noise"; }
-  echo "ok: $name"
-}
 expect_dir input_dir "cannot read the input file 'adir'" adir
 base '' '<Parameter name="Restart From" type="string" value="adir"/>' >restart_dir.xml
 expect_dir restart_dir "mupm->Solver->Restart From = 'adir' is a directory" restart_dir.xml
@@ -313,65 +262,6 @@ run 2 1 resume.xml >resume.out 2>&1 || { cat resume.out; fail "sigterm: the rest
 rows=$(tail -n +2 long/time_series.csv | cut -d, -f1 | sort -n | uniq -d | wc -l)
 [[ $rows == 0 ]] || fail "sigterm: time_series.csv repeats $rows step(s)"
 echo "ok: sigterm (exit 4 at step $stopped, resumed)"
-# Inputs that once ran with exit 0 and wrong results (or without end): refused by name, by the
-# run and by --validate.
-# Boundary Layer Horizons: floor(value * delta / dx) rows; 0.1 gave no row (conditions on the
-# layers did nothing), 1e9 overflowed the row count (0 points, "needs about -nan MiB").
-layer_hold() {  # a Displacement on 'Layer +y' appended to the input on stdin
-  sed '$d'
-  cat <<'XML'
-  <ParameterList name="Boundary Conditions"><ParameterList name="hold">
-    <Parameter name="Type" type="string" value="Displacement"/>
-    <Parameter name="Region" type="string" value="Layer +y"/>
-  </ParameterList></ParameterList>
-</ParameterList>
-XML
-}
-for v in 0.1:no_row 1e9:thicker; do
-  name=layer_${v#*:}
-  base "<Parameter name=\"Boundary Layers\" type=\"Array(string)\" value=\"{-y, +y}\"/><Parameter name=\"Boundary Layer Horizons\" type=\"double\" value=\"${v%:*}\"/>" '' |
-    layer_hold >"$name.xml"
-done
-expect layer_no_row 2 'mupm->Discretization->Boundary Layer Horizons = 0.1 gives layers of no row' 'The minimum is dx / delta = 0.331675'
-expect_dir layer_no_row_validate 'mupm->Discretization->Boundary Layer Horizons = 0.1' --validate layer_no_row.xml
-expect layer_thicker 2 'mupm->Discretization->Boundary Layer Horizons = 1e+09' 'thicker than the body along y (10 rows)'
-expect_dir layer_thicker_validate 'mupm->Discretization->Boundary Layer Horizons = 1e+09' --validate layer_thicker.xml
-# End Time beyond 1e12 steps (1e13 s of 1e-6 s steps: "the last step is -9223372036854775808" and
-# a run without end); with Automatic Time Step the run refuses it once dt is known.
-base '' '<Parameter name="End Time" type="double" value="1e13"/>' >end_time_huge.xml
-expect end_time_huge 2 'mupm->Solver->End Time = 1e+13 s takes 1e+19 steps' 'mupm->Solver->Time Step'
-expect_dir end_time_huge_validate 'mupm->Solver->End Time = 1e+13 s' --validate end_time_huge.xml
-base '' '<Parameter name="End Time" type="double" value="1e308"/>' >end_time_max.xml
-expect end_time_max 2 'mupm->Solver->End Time = 1e+308 s'
-base '' '<Parameter name="End Time" type="double" value="1e13"/><Parameter name="Automatic Time Step" type="bool" value="true"/>' >end_time_auto.xml
-expect end_time_auto 2 'mupm->Solver->End Time = 1e+13 s' "Automatic Time Step's estimate"
-# An Output->Folder below a regular file: said so (it was "not writable (Permission denied)").
-touch afile
-base '' '' | sed 's|value="out"|value="afile/sub"|' >folder_below_file.xml
-expect folder_below_file 2 "mupm->Output->Folder = 'afile/sub'" "afile' is a file, not a folder"
-expect_dir folder_below_file_validate "afile' is a file, not a folder" --validate folder_below_file.xml
-# Water in the crack (tests/cli/fracture_small.xml with Fracture Flow, injected at the notch's
-# mouth): a Minimum Aperture not below Spacing (1e50 m ran with nothing moving, 1e308 m ended in
-# a non-finite aperture), and a Fracture Source on a network without any fracture point (no
-# pre-crack: the water was dropped with exit 0) errs as one beside the crack does.
-sed -e 's|value="Micropolar Solid"|value="Hydro-Mechanical"|' \
-  -e 's|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/></ParameterList>&<Parameter name="Fracture Flow" type="bool" value="true"/><Parameter name="Minimum Aperture" type="double" value="1e-4"/>|' \
-  -e 's|<ParameterList name="Pre-Cracks">|<ParameterList name="Regions"><ParameterList name="mouth"><Parameter name="Min" type="Array(double)" value="{0, 0.045}"/><Parameter name="Max" type="Array(double)" value="{0.005, 0.055}"/></ParameterList></ParameterList>&|' \
-  -e 's|<ParameterList name="Boundary Conditions">|&<ParameterList name="mouth"><Parameter name="Type" type="string" value="Fracture Source"/><Parameter name="Region" type="string" value="mouth"/><Parameter name="Value" type="double" value="1e-2"/></ParameterList>|' \
-  -e 's|name="Number of Steps" type="int" value="440"|name="Number of Steps" type="int" value="2"|' \
-  "$SRC/tests/cli/fracture_small.xml" >crack_water.xml
-grep -q 'value="Fracture Source"' crack_water.xml && grep -q 'name="edge notch"' crack_water.xml ||
-  fail "tests/cli/fracture_small.xml changed: crack_water.xml not derived"
-sed 's|name="Minimum Aperture" type="double" value="1e-4"|name="Minimum Aperture" type="double" value="1e50"|' \
-  crack_water.xml >aperture_huge.xml
-expect aperture_huge 2 'mupm->Fracture->Minimum Aperture = 1e+50 m is not below the point spacing 0.0025 m'
-expect_dir aperture_huge_validate 'mupm->Fracture->Minimum Aperture = 1e+50' --validate aperture_huge.xml
-sed '/name="edge notch"/,/<\/ParameterList>/d' crack_water.xml >source_no_network.xml
-grep -q 'name="edge notch"' source_no_network.xml && fail "source_no_network.xml keeps the pre-crack"
-expect source_no_network 3 'mupm->Boundary Conditions->mouth (Fracture Source) has no fracture point in its region'
-sed -e 's|value="{0, 0.045}"|value="{0.08, 0.045}"|' -e 's|value="{0.005, 0.055}"|value="{0.09, 0.055}"|' \
-  crack_water.xml >source_off_crack.xml
-expect source_off_crack 3 'mupm->Boundary Conditions->mouth (Fracture Source) has no fracture point in its region'
 # A valid input validates, and --print-defaults is XML that documents every parameter.
 base '' '' >valid.xml
 # Threads pinned (OMP_PROC_BIND=spread) while the ranks' masks overlap (--bind-to none): warned.

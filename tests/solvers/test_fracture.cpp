@@ -288,6 +288,35 @@ TEST(FractureLong, BondEnergyOfEffectiveAndTotalForceState) {
   EXPECT_TRUE(eff.symmetric && tot.symmetric);
 }
 
+// crack_length of a 3D pre-crack: a rectangle overhanging the body (a corner below z = 0, an
+// edge beyond z = 0.08) measures as the same cut clipped to the body, its length along Edge 1
+// inside the body; its tip is the middle of the tip edge inside (crack_length was 0 and the
+// tip at z = -0.01 for the overhanging one). Body 0.08 m cubed (8 points of 0.01 m).
+TEST(Fracture, OverhangingPreCrackMeasuresItsPartInside) {
+  auto measure = [](double z0, double height, double x0) {
+    auto g = test::box<3>({8, 8, 8}, 3.015);
+    Crack c;  // in the plane y = 0.04, from x0 along +x by 0.03, from z0 along +z by height
+    c.a[0] = x0;
+    c.a[1] = 0.04;
+    c.a[2] = z0;
+    c.b[0] = 0.03;
+    c.c[2] = height;
+    g.cracks = {c};
+    auto disc = discretize(test::world(), g);
+    Damage<3> damage(disc, 0.3, MPI_COMM_WORLD);
+    damage.update();
+    return damage.crack_tip();
+  };
+  const auto inside = measure(0.0, 0.08, 0.0);
+  const auto over = measure(-0.01, 0.1, 0.0);
+  EXPECT_NEAR(inside.length, 0.03, 1e-15);
+  EXPECT_NEAR(over.length, 0.03, 1e-15);
+  EXPECT_NEAR(over.x[0], 0.03, 1e-15);
+  EXPECT_NEAR(over.x[2], 0.04, 1e-15);  // the middle of z in [0, 0.08]
+  // Overhanging along Edge 1 too: a corner at x = -0.01 leaves 0.02 m inside.
+  EXPECT_NEAR(measure(-0.01, 0.1, -0.01).length, 0.02, 1e-15);
+}
+
 TEST(Fracture, CriticalEnergyConstants) {
   // eq 36 and its 2D analogue (include/mupm/kernels/fracture.hpp), by the pair measures.
   const double G = 95, delta = 7.5e-3, h = 0.5;

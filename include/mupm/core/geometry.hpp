@@ -4,6 +4,7 @@
 #define MUPM_GEOMETRY_HPP
 
 #include <Kokkos_Core.hpp>
+#include <vector>
 
 namespace mupm {
 
@@ -119,6 +120,60 @@ KOKKOS_INLINE_FUNCTION double distance2_to_crack(const Crack& c, const double* x
     }
     return d2;
   }
+}
+
+// The part of a pre-crack inside a box (host only). A crack point is a + s D + t c, (s, t) in
+// [0, 1]^2, with D its direction (b - a in 2D, the edge b in 3D; t and c only in 3D). The part
+// inside is a convex polygon in (s, t): the unit square (2D: the segment t = 0) clipped by the
+// box's 2 Dim faces (Sutherland-Hodgman). Returns its extent [s0, s1] along D and the mean t of
+// its vertices at s1 (the middle of its tip edge inside the box); s0 > s1 when it misses the box.
+struct CrackPart {
+  double s0 = 1, s1 = 0, t = 0;
+};
+template <int Dim>
+CrackPart crack_inside(const Crack& c, const Box& box) {
+  struct P {
+    double s, t;
+  };
+  std::vector<P> poly =
+      Dim == 2 ? std::vector<P>{{0, 0}, {1, 0}} : std::vector<P>{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (int k = 0; k < Dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      const double D = Dim == 2 ? c.b[k] - c.a[k] : c.b[k], E = Dim == 2 ? 0.0 : c.c[k];
+      // f >= 0 inside this face's half-space.
+      auto f = [&](const P& p) {
+        const double x = c.a[k] + p.s * D + p.t * E;
+        return side == 0 ? x - box.lo[k] : box.hi[k] - x;
+      };
+      std::vector<P> out;
+      for (std::size_t i = 0; i < poly.size(); ++i) {
+        const P& p = poly[i];
+        const P& q = poly[(i + 1) % poly.size()];
+        const double fp = f(p), fq = f(q);
+        if ((fp >= 0) != (fq >= 0)) {
+          const double w = fp / (fp - fq);
+          out.push_back({p.s + w * (q.s - p.s), p.t + w * (q.t - p.t)});
+        }
+        if (fq >= 0)
+          out.push_back(q);
+      }
+      poly = out;
+      if (poly.empty())
+        return {};
+    }
+  CrackPart part{1e300, -1e300, 0};
+  for (const P& p : poly) {
+    part.s0 = p.s < part.s0 ? p.s : part.s0;
+    part.s1 = p.s > part.s1 ? p.s : part.s1;
+  }
+  int n = 0;
+  for (const P& p : poly)
+    if (p.s >= part.s1 - 1e-12) {
+      part.t += p.t;
+      ++n;
+    }
+  part.t /= n;
+  return part;
 }
 
 }  // namespace mupm

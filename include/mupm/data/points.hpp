@@ -178,7 +178,7 @@ struct Points {
     f(p.alpha,             FieldSpec{"micro_rotation_acceleration", R, kCheckpoint | kFinite});
     f(p.p,                 FieldSpec{"pore_pressure", 1, kState | kGhosted | kFinite, "Pore Pressure"});
     f(p.p_rate,            FieldSpec{"pore_pressure_rate", 1, kCheckpoint});
-    f(p.pf,                FieldSpec{"fracture_pressure", 1, kState | kGhosted | kFinite, "Fracture Pressure"});
+    f(p.pf,                FieldSpec{"fracture_pressure", 1, kState | kGhosted | kFinite});
     f(p.pf_rate,           FieldSpec{"fracture_pressure_rate", 1, kCheckpoint});
     f(p.pf_saturation,     FieldSpec{"fracture_saturation", 1, kState | kGhosted});
     f(p.pf_content,        FieldSpec{"fracture_fluid_content", 1, kState});

@@ -11,6 +11,7 @@
 
 #include "mupm/input/input.hpp"
 #include "mupm/input/options.hpp"
+#include "mupm/io/checkpoint.hpp"
 #include "mupm/kernels/fluid.hpp"
 #include "mupm/kernels/j_integral.hpp"
 #include "mupm/kernels/solid.hpp"
@@ -59,6 +60,7 @@ struct RunSettings {
   bool stop_on_energy_violation = false;
   long long energy_check_start = 20;
   std::string restart_from;
+  FixedSettings fixed;  // what a restart may not change (fixed_settings)
   // Output.
   std::string folder = "output";
   std::vector<std::string> fields;
@@ -86,10 +88,17 @@ struct Model {
   Kokkos::Array<double, 3> gravity{};  // Solver->Gravity
   std::vector<BoundaryCondition> boundary_conditions;
   std::vector<InitialCondition> initial_conditions;
+  std::vector<std::string> warnings;  // inputs that run but may mislead, said at the start
 };
 
 template <int Dim>
 Model<Dim> model_from_input(const Teuchos::ParameterList& input);
+
+// The settings a checkpoint records and a restart may not change (the checkpoint's state cannot
+// follow them): Solver->Physics, Discretization->Pre-Cracks, and where they act Materials->Model,
+// Fracture->Bond Breakage, Fracture->Fracture Flow and its Minimum Aperture. Others (material
+// constants, loads, output) a restart applies as given.
+FixedSettings fixed_settings(const Teuchos::ParameterList& input);
 
 }  // namespace mupm
 

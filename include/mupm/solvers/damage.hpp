@@ -8,7 +8,9 @@
 // Edge 1); d is the unit vector from Start (Corner) to T. The crack's grown part is the largest
 // projection s = (x - T).d over the real points (not boundary layers) that are fracture points
 // and not next to the pre-crack, if positive; the tip is that point (the lowest global id among
-// equals), else T. crack_length = (length of the segment Start -> T inside the real body) + s.
+// equals), else the middle of the pre-crack's tip edge inside the body (T in 2D when inside).
+// crack_length = (the pre-crack's extent along d inside the real body) + s: a 3D rectangle
+// overhanging the body counts as the same cut clipped to it (crack_inside, core/geometry.hpp).
 // For an edge crack from a face this is the distance from the face to the farthest fracture
 // point along the crack's direction, as the paper measures it. Damage elsewhere ahead of the
 // crack (e.g. at a loaded face) would count too: look at the damage field when in doubt.
@@ -110,10 +112,15 @@ class Damage : public Module {
         },
         Kokkos::Max<double>(best));
     MPI_Allreduce(MPI_IN_PLACE, &best, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    // The pre-crack's part inside the real body: its length along d, and the middle of its tip
+    // edge there (a 3D rectangle overhanging the body measured as the same cut clipped to it).
+    const CrackPart part = crack_inside<Dim>(c, body());
     Tip tip;
-    tip.length = inside_length(S, ahead.T) + std::max(best, 0.0);
+    tip.length = inside_length(c) + std::max(best, 0.0);
     for (int k = 0; k < Dim; ++k)
-      tip.x[k] = ahead.T[k];
+      tip.x[k] = part.s1 >= part.s0
+                     ? S[k] + part.s1 * (ahead.T[k] - S[k]) + (Dim == 3 ? part.t * c.c[k] : 0.0)
+                     : ahead.T[k];
     if (!(best > 0))
       return tip;
     long long mine = std::numeric_limits<long long>::max(), who = -1;
@@ -140,29 +147,27 @@ class Damage : public Module {
     return tip;
   }
 
-  // Length of the segment S -> T inside the real body (a box).
-  double inside_length(const double* S, const double* T) const {
-    const auto& g = disc_.grid;
-    double lo = 0, hi = 1, len2 = 0;
+  // Length of a crack's part inside the real body along its direction (crack_inside).
+  double inside_length(const Crack& c) const {
+    const CrackPart part = crack_inside<Dim>(c, body());
+    double len2 = 0;
     for (int k = 0; k < Dim; ++k) {
-      const double a = g.origin[k], b = g.origin[k] + double(g.counts[k]) * g.dx;
-      const double dk = T[k] - S[k];
-      len2 += dk * dk;
-      if (dk == 0) {
-        if (S[k] < a || S[k] > b)
-          return 0;
-        continue;
-      }
-      double t0 = (a - S[k]) / dk, t1 = (b - S[k]) / dk;
-      if (t0 > t1)
-        std::swap(t0, t1);
-      lo = std::max(lo, t0);
-      hi = std::min(hi, t1);
+      const double d = Dim == 2 ? c.b[k] - c.a[k] : c.b[k];
+      len2 += d * d;
     }
-    return hi > lo ? (hi - lo) * std::sqrt(len2) : 0.0;
+    return std::max(part.s1 - part.s0, 0.0) * std::sqrt(len2);
   }
 
  private:
+  Box body() const {
+    Box b;
+    for (int k = 0; k < Dim; ++k) {
+      b.lo[k] = disc_.grid.origin[k];
+      b.hi[k] = disc_.grid.origin[k] + double(disc_.grid.counts[k]) * disc_.grid.dx;
+    }
+    return b;
+  }
+
   // s = (x_i - T).d of a fracture point of the real body away from the pre-crack (header).
   struct Ahead {
     Vectors x;

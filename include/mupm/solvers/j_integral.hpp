@@ -85,7 +85,7 @@ class JIntegral : public Module {
       row("j_integral_" + std::to_string(k + 1), v[k].total);
     if (prm_.criterion) {  // the crack the criterion grew: the pre-crack in the body + n da
       const Crack& c = disc_.grid.cracks.front();
-      row("j_crack_length", damage_.inside_length(c.a, c.b) + advances_ * prm_.increment);
+      row("j_crack_length", damage_.inside_length(c) + advances_ * prm_.increment);
     }
   }
 
