@@ -1403,12 +1403,7 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
       }
     }
     // A crack that misses the body breaks no bond and would measure no length.
-    Box body;
-    for (int k = 0; k < Dim; ++k) {
-      body.lo[k] = g.origin[k];
-      body.hi[k] = g.origin[k] + double(g.counts[k]) * g.dx;
-    }
-    const CrackPart part = crack_inside<Dim>(cr, body);
+    const CrackPart part = crack_inside<Dim>(cr, g.body());
     if (!(part.s1 > part.s0))
       throw InputError("Error, " + c.name() +
                        " lies outside the body (or touches it in a point or along its surface "

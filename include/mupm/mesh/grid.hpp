@@ -43,6 +43,15 @@ struct GridSpec {
   double family_volume() const {
     return Dim == 2 ? kPi * horizon * horizon * thickness : 4.0 / 3.0 * kPi * std::pow(horizon, 3);
   }
+  // The real body [origin, origin + counts dx] (cell faces; points at cell centres).
+  Box body() const {
+    Box b;
+    for (int d = 0; d < Dim; ++d) {
+      b.lo[d] = origin[d];
+      b.hi[d] = origin[d] + double(counts[d]) * dx;
+    }
+    return b;
+  }
   double point_volume() const {
     double v = Dim == 2 ? thickness : 1.0;
     for (int d = 0; d < Dim; ++d)

@@ -114,7 +114,7 @@ class Damage : public Module {
     MPI_Allreduce(MPI_IN_PLACE, &best, 1, MPI_DOUBLE, MPI_MAX, comm_);
     // The pre-crack's part inside the real body: its length along d, and the middle of its tip
     // edge there (a 3D rectangle overhanging the body measured as the same cut clipped to it).
-    const CrackPart part = crack_inside<Dim>(c, body());
+    const CrackPart part = crack_inside<Dim>(c, disc_.grid.body());
     Tip tip;
     tip.length = inside_length(c) + std::max(best, 0.0);
     for (int k = 0; k < Dim; ++k)
@@ -149,7 +149,7 @@ class Damage : public Module {
 
   // Length of a crack's part inside the real body along its direction (crack_inside).
   double inside_length(const Crack& c) const {
-    const CrackPart part = crack_inside<Dim>(c, body());
+    const CrackPart part = crack_inside<Dim>(c, disc_.grid.body());
     double len2 = 0;
     for (int k = 0; k < Dim; ++k) {
       const double d = Dim == 2 ? c.b[k] - c.a[k] : c.b[k];
@@ -159,15 +159,6 @@ class Damage : public Module {
   }
 
  private:
-  Box body() const {
-    Box b;
-    for (int k = 0; k < Dim; ++k) {
-      b.lo[k] = disc_.grid.origin[k];
-      b.hi[k] = disc_.grid.origin[k] + double(disc_.grid.counts[k]) * disc_.grid.dx;
-    }
-    return b;
-  }
-
   // s = (x_i - T).d of a fracture point of the real body away from the pre-crack (header).
   struct Ahead {
     Vectors x;
