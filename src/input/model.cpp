@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 namespace mupm {
@@ -70,6 +71,12 @@ const Options<Physics>& physics_options() {
 const Options<Staggering>& staggering_options() {
   static const Options<Staggering> o("Staggering", {{"Solid First", Staggering::SolidFirst},
                                                     {"Fluid First", Staggering::FluidFirst}});
+  return o;
+}
+const Options<PressureIntegration>& pressure_integration_options() {
+  static const Options<PressureIntegration> o(
+      "Pressure Integration", {{"Explicit", PressureIntegration::Explicit},
+                               {"Semi-Implicit", PressureIntegration::SemiImplicit}});
   return o;
 }
 const Options<ConstitutiveModel>& constitutive_model_options() {
@@ -339,6 +346,17 @@ Model<Dim> model_from_input(const ParameterList& input) {
   r.staggering = staggering_options()(solver.get<std::string>("Staggering"));
   r.solid_steps_per_fluid_step = solver.get<int>("Solid Steps Per Fluid Step");
   r.fluid_substeps = solver.get<int>("Fluid Substeps");
+  r.semi_implicit =
+      pressure_integration_options()(solver.get<std::string>("Pressure Integration")) ==
+      PressureIntegration::SemiImplicit;
+  {
+    const ParameterList& ps = solver.sublist("Pressure Solve");
+    r.pressure_solve.method = ps.get<std::string>("Method");
+    r.pressure_solve.preconditioner = ps.get<std::string>("Preconditioner");
+    r.pressure_solve.fill_level = ps.get<int>("ILU Fill Level");
+    r.pressure_solve.tolerance = ps.get<double>("Tolerance");
+    r.pressure_solve.max_iterations = ps.get<int>("Maximum Iterations");
+  }
   r.time_step = solver.get<double>("Time Step");
   r.automatic_time_step = solver.get<bool>("Automatic Time Step");
   r.safety = solver.get<double>("Time Step Safety Factor");
@@ -400,7 +418,10 @@ Model<Dim> model_from_input(const ParameterList& input) {
             : fluid.get<double>("Hydraulic Conductivity") / (rho_w * kStandardGravity),
       fluid.get<double>("Flow Stabilization"));
   m.fluid.water_density = rho_w;
-  m.fluid.bulk_modulus = fluid.get<double>("Fluid Bulk Modulus");
+  m.fluid.bulk_modulus = fluid.get<bool>("Incompressible")
+                             ? std::numeric_limits<double>::infinity()
+                             : fluid.get<double>("Fluid Bulk Modulus");
+  m.fluid.semi_implicit = r.semi_implicit;
   if (retention_model_options()(fluid.get<std::string>("Retention Model")) ==
       RetentionModel::VanGenuchten) {
     m.fluid.retention = VanGenuchten::mualem(fluid.get<double>("Air Entry Pressure"),
@@ -472,6 +493,10 @@ FixedSettings fixed_settings(const ParameterList& input) {
         {std::string(list) + "->" + name, exact_text(input.sublist(list).getEntry(name)), why});
   };
   fix("Solver", "Physics", "the checkpoint's state holds that physics' fields and balances only");
+  if (physics == Physics::HydroMechanical)
+    fix("Solver", "Pressure Integration",
+        "the checkpoint's forces were applied with that scheme's pressure (the undrained split's "
+        "p* or p itself) and its energy ledger (the projection's work)");
   if (has_solid(physics)) {
     fix("Materials", "Model",
         "a Drucker-Prager state (plastic strains, softened cohesion, plastic dissipation) can "

@@ -307,6 +307,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
     settings.gravity = model.gravity;
     settings.damping = model.damping;
     settings.fracture = model.fracture;
+    settings.semi_implicit = model.run.semi_implicit;
     const auto& f = model.run.fields;
     if (model.constitutive_model == ConstitutiveModel::MicropolarDruckerPrager ||
         std::find(f.begin(), f.end(), "second_order_work") != f.end())
@@ -338,6 +339,10 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   }
   if (ph.fluid && model.fracture.flow)
     ph.fluid->enable_fracture_flow(model.fracture);
+  if (ph.fluid && model.run.semi_implicit) {  // input/model.cpp: Hydro-Mechanical, a solid
+    ph.fluid->enable_semi_implicit(model.run.pressure_solve);
+    ph.sequence.skeleton = dynamic_cast<Skeleton*>(ph.mechanics.get());
+  }
   ph.spacing = disc.grid.dx;
   ph.sequence.mechanics = ph.mechanics.get();
   ph.sequence.fluid = ph.fluid.get();
@@ -498,10 +503,13 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
       dt = ph.watch.time_step;
     else if (run.automatic_time_step)
       dt = safety * stable;
+    const bool implicit = ph.fluid && ph.fluid->semi_implicit();
     if (rank == 0) {
       out << "mupm: " << solid->describe() << "; estimated stable dt = " << stable << " s"
-          << (ph.fluid ? " (undrained: the pore water adds up to " : "");
-      if (ph.fluid)
+          << (implicit   ? " (drained: the pore pressure is semi-implicit)"
+              : ph.fluid ? " (undrained: the pore water adds up to "
+                         : "");
+      if (ph.fluid && !implicit)
         out << stiffening << " Pa to the bulk modulus)";
       out << "; dt = " << dt << " s" << (kept ? " (the restarted run's)" : "") << "\n";
       if (dt > safety * stable)
@@ -510,7 +518,15 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
             << " s: the run may blow up. Use a smaller Time Step or Automatic Time Step.\n";
     }
   }
-  if (ph.fluid) {
+  if (ph.fluid && ph.fluid->semi_implicit() && rank == 0) {
+    const auto& f = ph.fluid->params();
+    const auto& ls = run.pressure_solve;
+    out << "mupm: pore fluid, semi-implicit pressure: k/mu_w = " << f.mobility
+        << " m^2/(Pa s), K_w = " << f.bulk_modulus
+        << " Pa, flow stabilization G = " << f.stabilization << "; one solve per step ("
+        << ls.method << ", " << ls.preconditioner << ", tolerance " << ls.tolerance << ")\n";
+  }
+  if (ph.fluid && !ph.fluid->semi_implicit()) {
     auto& fluid = *ph.fluid;
     const double stable_f = three_digits(fluid.estimate_stable_dt());
     if (!solid && run.automatic_time_step)
@@ -575,7 +591,8 @@ class StableStepWatch {
   void operator()(long long step, double time) {
     const bool broke =
         solid_ && double(solid_->broken_pairs()) - ph_.watch.pairs_at >= 0.01 * pairs_;
-    const bool wetted = ph_.fluid && ph_.fluid->min_storage() < 0.5 * ph_.watch.storage_at;
+    const bool wetted = ph_.fluid && !ph_.fluid->semi_implicit() &&
+                        ph_.fluid->min_storage() < 0.5 * ph_.watch.storage_at;
     if (!broke && !wetted)
       return;
     ScopedRegion region("mupm::Solver::stable_step_update");
@@ -593,7 +610,7 @@ class StableStepWatch {
                << "with a smaller Time Step.\n";
       }
     }
-    if (ph_.fluid) {
+    if (ph_.fluid && !ph_.fluid->semi_implicit()) {
       const double stable_f = three_digits(ph_.fluid->estimate_stable_dt());
       const double interval = ph_.sequence.fluid_every * dt_;
       if (run_.fluid_substeps == 0) {

@@ -17,6 +17,7 @@
 #include "mupm/kernels/solid.hpp"
 #include "mupm/laws/micropolar_drucker_prager.hpp"
 #include "mupm/mesh/grid.hpp"
+#include "mupm/solvers/linear_solve.hpp"
 
 namespace mupm {
 
@@ -50,7 +51,9 @@ struct RunSettings {
   Physics physics = Physics::MicropolarSolid;
   Staggering staggering = Staggering::SolidFirst;
   int solid_steps_per_fluid_step = 1;
-  int fluid_substeps = 1;  // 0: automatic
+  int fluid_substeps = 1;              // 0: automatic
+  bool semi_implicit = false;          // Pressure Integration = Semi-Implicit
+  LinearSolveSettings pressure_solve;  // Solver->Pressure Solve
   double time_step = 1e-6;
   bool automatic_time_step = false;
   double safety = 0.5;

@@ -26,6 +26,8 @@ inline bool has_fluid(Physics p) {
 }
 // Solver->Staggering.
 enum class Staggering { SolidFirst, FluidFirst };
+// Solver->Pressure Integration.
+enum class PressureIntegration { Explicit, SemiImplicit };
 // Materials->Model.
 enum class ConstitutiveModel { MicropolarElastic, MicropolarDruckerPrager };
 // Fluid->Retention Model.
@@ -76,6 +78,7 @@ class Options {
 
 const Options<Physics>& physics_options();
 const Options<Staggering>& staggering_options();
+const Options<PressureIntegration>& pressure_integration_options();
 const Options<ConstitutiveModel>& constitutive_model_options();
 const Options<StabilizationModulus>& stabilization_modulus_options();
 const Options<RetentionModel>& retention_model_options();

@@ -56,11 +56,14 @@
 namespace mupm {
 
 struct FluidParams {
-  VanGenuchten retention;              // disabled: saturated everywhere
-  double mobility = 0;                 // k / mu_w [m^2/(Pa s)] (= K_h / (rho_w g))
-  double water_density = 1000;         // rho_w [kg/m^3]
-  double bulk_modulus = 2.2e9;         // K_w [Pa]
-  double stabilization = 0.5;          // G (eq 76)
+  VanGenuchten retention;       // disabled: saturated everywhere
+  double mobility = 0;          // k / mu_w [m^2/(Pa s)] (= K_h / (rho_w g))
+  double water_density = 1000;  // rho_w [kg/m^3]
+  double bulk_modulus = 2.2e9;  // K_w [Pa]
+  double stabilization = 0.5;   // G (eq 76)
+  // Solver->Pressure Integration = Semi-Implicit (include/mupm/solvers/pressure_projection.hpp):
+  // the solid sees p itself, no undrained split (Points::undrained_modulus = 0).
+  bool semi_implicit = false;
   double horizon_volume = 0;           // V_H: volume of a full continuous family
   double second_moment = 0;            // k2 = int_H |xi|^2 / Dim dV
   Kokkos::Array<double, 3> gravity{};  // g in Darcy's law (all zero: no gravity term)
@@ -116,6 +119,7 @@ void fluid_constitutive(const Points<Dim>& pts, const FluidParams& prm, FluidSta
   auto C = st.storage;
   const VanGenuchten vg = prm.retention;
   const double inv_kw = 1.0 / prm.bulk_modulus;
+  const bool split = !prm.semi_implicit;
   Kokkos::parallel_for(
       "mupm::Fluid::constitutive", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         const double s = vg.saturation(p(i));
@@ -123,7 +127,7 @@ void fluid_constitutive(const Points<Dim>& pts, const FluidParams& prm, FluidSta
         kr(i) = vg.relative_permeability(s);
         const double c = phi(i) * (vg.dsaturation_dp(p(i)) + s * inv_kw);
         C(i) = c;
-        bu(i) = (fixed(i) & kFixedPressure) || !(c > 0) ? 0.0 : s / c;
+        bu(i) = !split || (fixed(i) & kFixedPressure) || !(c > 0) ? 0.0 : s / c;
       });
 }
 

@@ -43,15 +43,18 @@
 
 #include <cmath>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "mupm/core/error.hpp"
 #include "mupm/kernels/boundary_conditions.hpp"
 #include "mupm/kernels/fluid.hpp"
 #include "mupm/mesh/discretization.hpp"
 #include "mupm/solvers/fracture_flow.hpp"
 #include "mupm/solvers/module.hpp"
 #include "mupm/solvers/power_iteration.hpp"
+#include "mupm/solvers/pressure_projection.hpp"
 
 namespace mupm {
 
@@ -129,6 +132,8 @@ class FluidSolver : public Module {
     g("dissipation", energy_.dissipation);
     g("external_work", energy_.external_work);
     g("fluid_mass_initial", mass0_);
+    if (semi_implicit())  // the pressure solves' scale (LinearSolve::solve)
+      g("pressure_solve_scale", solve_scale_);
     if (fracture_) {
       for (std::size_t k = 0; k < fracture_->conditions().size(); ++k)
         g("inflow_" + fracture_->conditions()[k].name, fracture_->inflows()[k]);
@@ -169,6 +174,11 @@ class FluidSolver : public Module {
       row("fracture_fluid_external_work", fe.external_work);
       row("fracture_fluid_exchange_work", fe.exchange_work);
       row("fracture_fluid_energy_error", fe.balance());
+    }
+    if (semi_implicit()) {  // the last step's pressure solve (pressure_projection.hpp)
+      row("pressure_solve_iterations", stats_.iterations);
+      row("pressure_solve_residual", stats_.residual);
+      row("pressure_assemblies", stats_.assemblies);
     }
     // Water conservation [kg]: bulk + fracture - initial - everything that entered.
     row("fluid_mass_error", (bulk + fracture - mass0_) - supplied);
@@ -237,6 +247,8 @@ class FluidSolver : public Module {
       region_volume_[k] = v;
     }
     mark_mirrored();
+    if (semi_implicit() && !projection_)
+      make_projection();
     if (!restarted) {
       set_pressure(t, p.p);
       if (mirrored_.extent(0) > 0) {
@@ -259,7 +271,105 @@ class FluidSolver : public Module {
   }
 
   // The bond set changed (fracture): the flow of the current pressure again.
-  void bonds_changed() { evaluate(); }
+  void bonds_changed() {
+    evaluate();
+    if (projection_)
+      projection_->invalidate();
+  }
+
+  // Solver->Pressure Integration = Semi-Implicit (include/mupm/solvers/pressure_projection.hpp),
+  // before initialize(); FluidParams::semi_implicit must be set (no undrained split).
+  void enable_semi_implicit(const LinearSolveSettings& settings) {
+    if (!prm_.semi_implicit)
+      throw std::logic_error(
+          "FluidSolver: semi-implicit pressure without FluidParams::semi_implicit");
+    if (fracture_)
+      throw std::logic_error("FluidSolver: the semi-implicit pressure has no fracture flow yet");
+    solve_settings_ = settings;
+    const std::size_t n = disc_.points.n_owned;
+    for (auto* v : {&dp_, &hdp_, &c_old_, &sr_old_, &flow_old_})
+      *v = Scalars("mupm::projection_state", n);
+  }
+  bool semi_implicit() const { return dp_.extent(0) > 0; }
+  struct SolveStats {
+    double iterations = 0, residual = 0, assemblies = 0;
+  };
+  // The last pressure solve's iterations and residual, and the assemblies so far.
+  SolveStats solve_stats() const { return stats_; }
+
+  // Steps 2-3 of pressure_projection.hpp between the skeleton's move() and finish(): the new
+  // pressure at t + dt, the skeleton corrected; then the state of the new pressure. The water
+  // and energy are booked by finish_projection() once the skeleton's volume change is known.
+  void project(double t, double dt, Skeleton& skeleton) {
+    auto& p = disc_.points;
+    const auto owned = std::make_pair(std::size_t(0), p.n_owned);
+    sources(t, dt);
+    auto target = supply_;
+    Kokkos::deep_copy(target, 0.0);
+    set_pressure(t + dt, target);
+    if (mirrored_.extent(0) > 0)
+      set_pressure(t + dt, target, true);  // the images of the mirrors' p_n (ghosts current)
+    Kokkos::deep_copy(c_old_, st_.storage);
+    Kokkos::deep_copy(sr_old_, Kokkos::subview(p.saturation, owned));
+    Kokkos::deep_copy(flow_old_, st_.flow);
+    const auto r = projection_->step(dt, prm_, st_, source_, target, skeleton.skeleton_state(), dp_,
+                                     solve_scale_);
+    stats_ = {double(r.iterations), r.residual, double(projection_->assemblies())};
+    if (!r.converged) {
+      std::ostringstream m;
+      m << "the pressure solve did not converge at t = " << t + dt << " s: relative residual "
+        << r.residual << " after " << r.iterations
+        << " iterations (mupm->Solver->Pressure Solve: Tolerance, Maximum Iterations, "
+           "Preconditioner)";
+      throw CollectiveError(m.str());
+    }
+    skeleton.add_projection_work(r.work);
+    projection_->flow_increment(dp_, hdp_);
+    auto pw = p.p, rate = p.p_rate, dp = dp_;
+    Kokkos::parallel_for(
+        "mupm::Fluid::projected_pressure", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
+          pw(i) += dp(i);
+          rate(i) = dp(i) / dt;
+        });
+    evaluate();
+  }
+
+  // The water and energy of the step just projected (header of pressure_projection.hpp), with
+  // the skeleton's volume change since the last fluid update (after its finish()).
+  void finish_projection(double dt) {
+    ScopedRegion region("mupm::Fluid::book_projection");
+    auto& p = disc_.points;
+    auto target = supply_;
+    auto pw = p.p, m = p.fluid_content, vol = p.volume, phi = p.porosity;
+    auto vs = p.vol_strain, ref = p.vol_strain_ref;
+    auto fixed = p.fixed;
+    auto C = c_old_, sr = sr_old_, f0 = flow_old_, hdp = hdp_, ddp = dp_, src = source_;
+    const VanGenuchten vg = prm_.retention;
+    const double inv_kw = 1.0 / prm_.bulk_modulus;
+    double w[3] = {0, 0, 0};
+    Kokkos::parallel_reduce(
+        "mupm::Fluid::book_projection", range(0, p.n_owned),
+        KOKKOS_LAMBDA(const std::size_t i, double& wc, double& wd, double& we) {
+          const double dv = vs(i) - ref(i), dp = ddp(i), p0 = pw(i) - dp;
+          const double flow = f0(i) + hdp(i) / vol(i);  // div(p_n) + H dp: backward Euler's
+          const double rhs = -sr(i) * dv + dt * (src(i) - flow);
+          const bool held = fixed(i) & kFixedPressure;
+          target(i) = held ? vol(i) * (C(i) * dp - rhs) : 0.0;  // the reservoir's water [m^3]
+          const double pm = p0 + 0.5 * dp;
+          double pe = pm;  // as in substep(): the pressure at which the storage takes water in
+          if ((src(i) != 0 || held) && C(i) * dp != 0)
+            pe = (stored_energy_density(vg, phi(i), inv_kw, p0 + dp) -
+                  stored_energy_density(vg, phi(i), inv_kw, p0)) /
+                 (C(i) * dp);
+          wc += vol(i) * pm * sr(i) * dv;
+          wd += vol(i) * pm * dt * flow;
+          we += vol(i) * pe * dt * src(i) + pe * target(i);
+          m(i) += C(i) * dp + sr(i) * dv;
+        },
+        w[0], w[1], w[2]);
+    book(target, w);
+    reset_strain_reference();
+  }
 
   void reset_strain_reference() {
     auto& p = disc_.points;
@@ -379,6 +489,24 @@ class FluidSolver : public Module {
     disc_.dist.refresh({as_vectors(p.p)});
     mirror_rel_perm();
     fluid_flow(disc_, prm_, st_, p.p);
+  }
+
+  // The semi-implicit step's roles of the owned points (held, images, free), from the marks.
+  void make_projection() {
+    const auto& p = disc_.points;
+    std::vector<PressureRole> roles(p.n_owned, PressureRole::Free);
+    std::vector<LocalId> images(p.n_owned, -1);
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      const int f = mirrored_.extent(0) > 0 ? mirrored_(i) : 0;
+      if (f) {
+        roles[i] = f > kEvenMirror ? PressureRole::EvenImage : PressureRole::OddImage;
+        images[i] = disc_.mirror(i, mirror_column(f));
+      } else if (p.fixed(i) & kFixedPressure) {
+        roles[i] = PressureRole::Held;
+      }
+    }
+    projection_ =
+        std::make_unique<PressureProjection<Dim>>(disc_, solve_settings_, roles, images, comm_);
   }
 
   // The mirrored layer points (Pore Pressure and Fluid Flux, mirrored_) take their mirror's k_r
@@ -509,11 +637,12 @@ class FluidSolver : public Module {
   }
 
   // One forward-Euler step from t to t + dt (eqs 141-146). evaluate() has run for the state at t.
-  void substep(double t, double dt, double dt_total) {
+  // Sources [1/s] at t into source_: rate g(t) (per metre of thickness in 2D) over the
+  // region's volume; books the water they bring over dt.
+  void sources(double t, double dt) {
     auto& p = disc_.points;
-    const double h = Dim == 2 ? disc_.grid.thickness : 1.0;
     auto regions = p.regions;
-    // Sources [1/s]: rate g(t) (per metre of thickness in 2D) over the region's volume.
+    const double h = Dim == 2 ? disc_.grid.thickness : 1.0;
     Kokkos::deep_copy(source_, 0.0);
     for (std::size_t k = 0; k < bcs_.size(); ++k) {
       const auto& bc = bcs_[k];
@@ -529,6 +658,12 @@ class FluidSolver : public Module {
           });
       inflow_[k] += prm_.water_density * bc.value * bc.time(t) * h * dt;
     }
+  }
+
+  void substep(double t, double dt, double dt_total) {
+    auto& p = disc_.points;
+    auto regions = p.regions;
+    sources(t, dt);
     // Prescribed pressures at t + dt go to supply_ first (the target), then the update.
     auto target = supply_;
     Kokkos::deep_copy(target, 0.0);
@@ -607,6 +742,17 @@ class FluidSolver : public Module {
       set_pressure(t + dt, target, true);
       update(1);
     }
+    book(target, w);
+    evaluate();
+  }
+
+  // Books a step's water and energy: `supply` the water each held point's reservoir supplied
+  // [m^3] (summed per pressure condition), w the coupling work, flow dissipation and external
+  // work of this rank's points.
+  void book(const Scalars& supply, const double w[3]) {
+    auto& p = disc_.points;
+    auto regions = p.regions;
+    auto target = supply;
     std::vector<double> supplied(bcs_.size() + 3, 0.0);
     supplied[bcs_.size()] = w[0];
     supplied[bcs_.size() + 1] = w[1];
@@ -642,7 +788,6 @@ class FluidSolver : public Module {
     energy_.coupling_work += supplied[bcs_.size()];
     energy_.dissipation += supplied[bcs_.size() + 1];
     energy_.external_work += supplied[bcs_.size() + 2];
-    evaluate();
   }
 
   Discretization<Dim>& disc_;
@@ -657,6 +802,13 @@ class FluidSolver : public Module {
   Bytes mirrored_;  // mark_mirrored()
   std::vector<double> inflow_, region_volume_;
   Energy energy_;
+  // Semi-implicit pressure: the solve, the step's increment, V H dp, and the storage,
+  // saturation and flow at p_n (the matrix's), kept from project() for finish_projection().
+  LinearSolveSettings solve_settings_;
+  std::unique_ptr<PressureProjection<Dim>> projection_;
+  Scalars dp_, hdp_, c_old_, sr_old_, flow_old_;
+  SolveStats stats_;
+  double solve_scale_ = 0;
 };
 
 }  // namespace mupm

@@ -85,6 +85,27 @@ class Mechanics : public Module {
   virtual long long broken_pairs() const { return 0; }
 };
 
+// The skeleton as the semi-implicit pressure step sees it (include/mupm/solvers/
+// pressure_projection.hpp): (u, theta) at the step's start [n_owned][Dim + R] (after move()),
+// the density rho and micro-inertia J [n_owned] of its lumped masses.
+struct SkeletonState {
+  Vectors start;
+  Scalars density, inertia;
+};
+
+// A mechanics whose step the semi-implicit pressure splits: move() advances the positions,
+// the pressure step corrects the free components of (u, v, theta, omega), finish() does the
+// rest (step() is move() then finish()).
+class Skeleton {
+ public:
+  virtual ~Skeleton() = default;
+  virtual void move(double t, double dt) = 0;
+  virtual void finish(double t, double dt) = 0;
+  virtual SkeletonState skeleton_state() const = 0;
+  // The correction's work on the skeleton [J] (summed over ranks), for the energy ledger.
+  virtual void add_projection_work(double w) = 0;
+};
+
 // sum_i f_i V_i over the owned points of all ranks (e.g. a water content times the volume).
 inline double volume_integral(const Scalars& f, const Scalars& vol, std::size_t n_owned,
                               MPI_Comm comm) {

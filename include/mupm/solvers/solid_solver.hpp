@@ -77,12 +77,15 @@ struct SolidSettings {
   // Steps per window of the second-order work (eq 42, include/mupm/kernels/shear_bands.hpp);
   // 0: none.
   int second_order_window = 0;
+  // Solver->Pressure Integration = Semi-Implicit: the pore pressure's correction of each step
+  // is booked (add_projection_work) and reported.
+  bool semi_implicit = false;
 };
 
 // Law: the pointwise constitutive law of pass 1 (include/mupm/kernels/solid.hpp), chosen once
 // by the driver from Materials->Model.
 template <int Dim, class Law = MicropolarElastic>
-class SolidSolver : public Mechanics {
+class SolidSolver : public Mechanics, public Skeleton {
  public:
   static constexpr int R = kRotDim<Dim>;
 
@@ -181,6 +184,8 @@ class SolidSolver : public Mechanics {
     g("dissipation", dissipation_);
     g("pore_pressure_work", pore_work_);
     g("initial_balance", balance0_);
+    if (set_.semi_implicit)
+      g("projection_work", projection_work_);
     if (face_pressure())
       g("crack_force_work", crack_work_);
     if (breaks()) {
@@ -205,6 +210,8 @@ class SolidSolver : public Mechanics {
     row("external_work", e.external_work);
     row("dissipation", e.dissipation);
     row("pore_pressure_work", e.pore_work);
+    if (set_.semi_implicit)  // its part from the pressure correction (pressure_projection.hpp)
+      row("projection_work", projection_work_);
     if (face_pressure())
       row("crack_force_work", e.crack_work);
     if (breaks()) {
@@ -297,8 +304,15 @@ class SolidSolver : public Mechanics {
     }
   }
 
-  // One step from t to t + dt.
+  // One step from t to t + dt: move() then finish().
   void step(double t, double dt) override {
+    move(t, dt);
+    finish(t, dt);
+  }
+  // The step's first half: the velocities' first half and the positions at t + dt, prescribed
+  // components at their values. The semi-implicit pressure corrects the free components here
+  // (include/mupm/solvers/pressure_projection.hpp).
+  void move(double t, double dt) override {
     ScopedRegion region("mupm::Solid::step");
     auto& p = disc_.points;
     if constexpr (Law::plastic)
@@ -306,6 +320,17 @@ class SolidSolver : public Mechanics {
     save_positions();
     advance_positions(p, dt);
     apply_kinematic(bcs_, p, t, dt);
+  }
+  SkeletonState skeleton_state() const override { return {du_, rho_, inertia_}; }
+  // The pressure correction's work on the skeleton, part of the pore work (W_pore).
+  void add_projection_work(double w) override {
+    pore_work_ += w;
+    projection_work_ += w;
+  }
+  // The rest of the step: boundary layers, forces at t + dt, work, breakage, velocities.
+  void finish(double t, double dt) override {
+    ScopedRegion region("mupm::Solid::step");
+    auto& p = disc_.points;
     if (slaved_)  // 2 dg of each slaved condition (twice_dg_)
       for (std::size_t k = 0; k < bcs_.size(); ++k) {
         const auto& bc = bcs_[k];
@@ -968,6 +993,7 @@ class SolidSolver : public Mechanics {
   Vectors f_old_, l_old_;   // forces of the old bond set at a breakage
   Scalars vs_old_;
   double work_ = 0, dissipation_ = 0, pore_work_ = 0, balance0_ = 0;
+  double projection_work_ = 0;  // add_projection_work (Semi-Implicit)
   double crack_work_ = 0;       // work of the crack water's face forces since t = 0 [J] (Energy)
   double fracture_energy_ = 0;  // strain energy lost to bond breakage since t = 0 [J]
   double plastic_dissipation_ = 0;   // plastic dissipation since t = 0 [J] (plastic law)

@@ -27,13 +27,35 @@ struct StepSequence {
   int substeps = 1;
   long long damage_seen = -1;  // broken bond pairs at the last damage update (bookkeeping)
 
+  // Solver->Pressure Integration = Semi-Implicit: the solid's step split around the pressure
+  // solve (include/mupm/solvers/pressure_projection.hpp): move, pressure, finish, breakage and
+  // damage, then the fluid's water and energy bookkeeping; every step, no substeps.
+  Skeleton* skeleton = nullptr;
+
   // Step number `step` (0-based, counted from t = 0 so restarts keep the intervals), t -> t + dt.
   void step(long long step, double t, double dt) {
+    if (skeleton && fluid && fluid->semi_implicit()) {
+      skeleton->move(t, dt);
+      fluid->project(t, dt, *skeleton);
+      skeleton->finish(t, dt);
+      after_mechanics();
+      fluid->finish_projection(dt);
+      mechanics->update_density();
+      return;
+    }
     const double interval = fluid_every * dt;
     if (fluid && fluid_first && step % fluid_every == 0)
       advance_fluid(t, interval);
     if (mechanics)
       mechanics->step(t, dt);
+    after_mechanics();
+    // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
+    if (fluid && !fluid_first && (step + 1) % fluid_every == 0)
+      advance_fluid(mechanics ? t + dt - interval : t, interval);
+  }
+
+ private:
+  void after_mechanics() {
     // Bonds broke in the mechanics step: the damage changes (the pre-cracks' is computed at
     // the start), and so does the fluid's flow of the current pressure (K^-1 and the families).
     if (damage && mechanics && mechanics->broken_pairs() != damage_seen) {
@@ -46,12 +68,7 @@ struct StepSequence {
     // (pre-cracks included) every step (the solid left u current on the ghosts).
     if (damage && mechanics)
       damage->update_aperture();
-    // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
-    if (fluid && !fluid_first && (step + 1) % fluid_every == 0)
-      advance_fluid(mechanics ? t + dt - interval : t, interval);
   }
-
- private:
   void advance_fluid(double t, double interval) {
     fluid->advance(t, interval, substeps);
     if (mechanics)

@@ -1,0 +1,112 @@
+#include "mupm/solvers/linear_solve.hpp"
+
+#include <BelosLinearProblem.hpp>
+#include <BelosSolverFactory.hpp>
+#include <BelosTpetraAdapter.hpp>
+#include <Ifpack2_Factory.hpp>
+#include <Teuchos_ParameterList.hpp>
+#include <algorithm>
+#include <stdexcept>
+
+#include "mupm/core/timers.hpp"
+
+namespace mupm {
+
+namespace {
+using MV = Tpetra::MultiVector<double, LocalId, GlobalId>;
+using OP = Tpetra::Operator<double, LocalId, GlobalId>;
+using RowMatrix = Tpetra::RowMatrix<double, LocalId, GlobalId>;
+using Preconditioner = Ifpack2::Preconditioner<double, LocalId, GlobalId>;
+}  // namespace
+
+struct LinearSolve::Impl {
+  Teuchos::RCP<Teuchos::ParameterList> params;
+  Teuchos::RCP<const CrsMatrix> a;
+  Teuchos::RCP<Preconditioner> prec;
+  Teuchos::RCP<Belos::LinearProblem<double, MV, OP>> problem;
+  Teuchos::RCP<Belos::SolverManager<double, MV, OP>> solver;
+};
+
+LinearSolve::LinearSolve(const LinearSolveSettings& settings)
+    : set_(settings), impl_(Teuchos::rcp(new Impl)) {
+  if (set_.method != "GMRES" && set_.method != "CG")
+    throw std::invalid_argument("LinearSolve: method '" + set_.method + "' is not GMRES or CG");
+  if (set_.preconditioner != "ILU" && set_.preconditioner != "Jacobi" &&
+      set_.preconditioner != "None")
+    throw std::invalid_argument("LinearSolve: preconditioner '" + set_.preconditioner +
+                                "' is not ILU, Jacobi or None");
+  auto params = Teuchos::parameterList();
+  params->set("Convergence Tolerance", set_.tolerance);
+  params->set("Maximum Iterations", set_.max_iterations);
+  if (set_.method == "GMRES") {
+    params->set("Num Blocks", set_.restart);
+    params->set("Maximum Restarts", set_.max_iterations / std::max(1, set_.restart) + 1);
+  }
+  params->set("Verbosity", 0);
+  // Relative to ||b|| (Belos' default is the initial residual, which a good initial guess
+  // makes small and the test then needlessly strict).
+  params->set("Implicit Residual Scaling", std::string("Norm of RHS"));
+  params->set("Explicit Residual Scaling", std::string("Norm of RHS"));
+  Belos::SolverFactory<double, MV, OP> factory;
+  impl_->solver = factory.create(set_.method == "CG" ? "CG" : "GMRES", params);
+  impl_->params = params;
+  impl_->problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>());
+}
+
+LinearSolve::~LinearSolve() = default;
+
+void LinearSolve::set_matrix(const Teuchos::RCP<const CrsMatrix>& a) {
+  ScopedRegion region("mupm::LinearSolve::setup");
+  impl_->a = a;
+  impl_->problem->setOperator(a);
+  impl_->prec = Teuchos::null;
+  if (set_.preconditioner != "None") {
+    Teuchos::ParameterList p;
+    const bool ilu = set_.preconditioner == "ILU";
+    if (ilu) {
+      p.set("fact: iluk level-of-fill", set_.fill_level);
+    } else {
+      p.set("relaxation: type", "Jacobi");
+      p.set("relaxation: sweeps", 1);
+    }
+    Teuchos::RCP<const RowMatrix> rows = a;
+    impl_->prec = Ifpack2::Factory::create<RowMatrix>(ilu ? "RILUK" : "RELAXATION", rows);
+    impl_->prec->setParameters(p);
+    impl_->prec->initialize();
+    impl_->prec->compute();
+    impl_->problem->setRightPrec(impl_->prec);
+  }
+  ++setups_;
+}
+
+LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, double& scale) {
+  ScopedRegion region("mupm::LinearSolve::solve");
+  if (impl_->a.is_null())
+    throw std::logic_error("LinearSolve::solve before set_matrix");
+  // The tolerance holds for ||b - A x|| against the largest ||b|| of the run so far, not this
+  // one's: a step whose right-hand side is round-off (a steady state) needs no digits of it.
+  LinearSolveResult r;
+  const double bn = b.norm2();
+  scale = std::max(scale, bn);
+  if (!(bn > 0)) {
+    x.putScalar(0.0);
+    r.converged = true;
+    return r;
+  }
+  const double tol = std::min(0.5, set_.tolerance * scale / bn);
+  impl_->params->set("Convergence Tolerance", tol);
+  impl_->solver->setParameters(impl_->params);
+  Teuchos::RCP<MV> xv = Teuchos::rcpFromRef(static_cast<MV&>(x));
+  Teuchos::RCP<const MV> bv = Teuchos::rcpFromRef(static_cast<const MV&>(b));
+  impl_->problem->setLHS(xv);
+  impl_->problem->setRHS(bv);
+  if (!impl_->problem->setProblem())
+    throw std::logic_error("LinearSolve: Belos could not set up the problem");
+  impl_->solver->setProblem(impl_->problem);
+  r.converged = impl_->solver->solve() == Belos::Converged;
+  r.iterations = impl_->solver->getNumIters();
+  r.residual = impl_->solver->achievedTol() * bn / scale;
+  return r;
+}
+
+}  // namespace mupm

@@ -1,0 +1,191 @@
+// The semi-implicit pressure step (include/mupm/solvers/pressure_projection.hpp) and its
+// assembled operators (include/mupm/solvers/pressure_system.hpp): each matrix against the
+// kernels it stands for, then closed forms at the drained skeleton's step.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mupm/input/model.hpp"
+#include "mupm/solvers/fluid_solver.hpp"
+#include "mupm/solvers/pressure_system.hpp"
+#include "solid_body.hpp"
+#include "test_utils.hpp"
+
+namespace mupm {
+namespace {
+
+double global_max(double v) {
+  MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return v;
+}
+
+// A smooth field with a rough part, the same on every rank (a function of the position).
+double field(const double* x, int c) {
+  return std::sin(37 * x[0] + 3 * c) * std::cos(23 * x[1] - c) + 0.3 * std::sin(91 * x[0] * x[1]) +
+         (x[2] != 0 ? 0.2 * std::cos(53 * x[2]) : 0.0);
+}
+
+template <int Dim>
+void fill(const Points<Dim>& p, const Vectors& out, int offset = 0) {
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    double x[3] = {0, 0, 0};
+    for (int d = 0; d < Dim; ++d)
+      x[d] = p.x(i, d);
+    for (std::size_t c = 0; c < out.extent(1); ++c)
+      out(i, c) = field(x, int(c) + offset);
+  }
+}
+
+// Largest |a - b| over the owned rows, relative to the largest |b| (all ranks).
+double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double diff = 0, scale = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    diff = std::max(diff, std::abs(a[k] - b[k]));
+    scale = std::max(scale, std::abs(b[k]));
+  }
+  const double largest = global_max(scale), r = global_max(diff) / largest;
+  if (test::world()->getRank() == 0)
+    std::printf("[ operator ] largest difference %.2e of the largest value %.3e\n", r, largest);
+  return r;
+}
+
+// V H p against V_i div_i(p) of the fluid's passes, unsaturated (k_r and alpha vary).
+template <int Dim>
+void check_flow_operator() {
+  std::array<long long, Dim> counts;
+  counts.fill(9);
+  counts[0] = 12;
+  auto disc = discretize(test::world(), test::box<Dim>(counts, 3.015));
+  auto& p = disc.points;
+  Kokkos::deep_copy(p.porosity, 0.3);
+  auto fp = fluid_params(disc.grid, 1e-9, 0.5);
+  fp.retention = VanGenuchten::mualem(2e4, 1.8);
+  fill(p, as_vectors(p.p));
+  Kokkos::parallel_for(
+      range(0, p.size()), KOKKOS_LAMBDA(const std::size_t i) { p.p(i) *= -3e4; });
+  FluidState<Dim> st;
+  st.allocate(p.size(), p.n_owned);
+  fluid_constitutive(p, fp, st);
+  Scalars x("x", p.size());
+  fill(p, as_vectors(x), 5);
+  fluid_flow(disc, fp, st, x, false);
+  const auto H = assemble_flow_operator(disc, fp, st);
+  TpetraVector xv(disc.dist.owned_map()), y(disc.dist.owned_map());
+  {
+    auto v = xv.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < p.n_owned; ++i)
+      v(i, 0) = x(i);
+  }
+  H->apply(xv, y);
+  std::vector<double> a(p.n_owned), b(p.n_owned);
+  auto yv = y.getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    a[i] = yv(i, 0);
+    b[i] = p.volume(i) * st.flow(i);
+  }
+  EXPECT_LT(relative_difference(a, b), 1e-12);
+  // Symmetric: x . H y = y . H x for two fields.
+  TpetraVector z(disc.dist.owned_map()), hz(disc.dist.owned_map());
+  {
+    auto v = z.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      double xi[3] = {0, 0, 0};
+      for (int d = 0; d < Dim; ++d)
+        xi[d] = p.x(i, d);
+      v(i, 0) = field(xi, 9);
+    }
+  }
+  H->apply(z, hz);
+  const double xhz = xv.dot(hz), zhx = z.dot(y);
+  EXPECT_NEAR(xhz, zhx, 1e-12 * std::abs(xhz));
+  EXPECT_GT(xv.dot(y), 0) << "positive semi-definite: x . H x >= 0";
+}
+
+TEST(PressureProjection, FlowOperatorIsTheFluidsDivergence2D) {
+  check_flow_operator<2>();
+}
+TEST(PressureProjection, FlowOperatorIsTheFluidsDivergence3D) {
+  check_flow_operator<3>();
+}
+
+// B~ (u, theta) against V S_r tr(eps) of the solid's pass 1, and B~^T p against V (f, l) of the
+// solid's passes with the pore pressure p alone (u = theta = 0, no undrained split).
+template <int Dim>
+void check_coupling() {
+  constexpr int R = kRotDim<Dim>, NC = Dim + R;
+  std::array<long long, Dim> counts;
+  counts.fill(8);
+  counts[0] = 11;
+  const auto law = MicropolarElastic::from_bulk_shear(10e6, 6e6, 3e6, 0.01);
+  test::Body<Dim> body(test::box<Dim>(counts, 3.015), law, 0.5);
+  auto& p = body.pts();
+  auto sr = p.saturation;
+  Kokkos::parallel_for(
+      range(0, p.size()),
+      KOKKOS_LAMBDA(const std::size_t i) { sr(i) = 0.6 + 0.001 * double(i % 7); });
+  const auto B = assemble_volume_coupling(body.disc);
+  const auto dofs = component_map(body.disc, NC, false);
+  // Strain: u, theta a rough field on every point (ghosts included).
+  fill(p, p.u);
+  fill(p, p.theta, 7);
+  body.forces();
+  TpetraVector uv(dofs), bu(body.disc.dist.owned_map());
+  {
+    auto v = uv.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      for (int d = 0; d < Dim; ++d)
+        v(i * NC + d, 0) = p.u(i, d);
+      for (int r = 0; r < R; ++r)
+        v(i * NC + Dim + r, 0) = p.theta(i, r);
+    }
+  }
+  B->apply(uv, bu);
+  std::vector<double> a(p.n_owned), b(p.n_owned);
+  {
+    auto v = bu.getLocalViewHost(Tpetra::Access::ReadOnly);
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      double tr = 0;
+      for (int d = 0; d < Dim; ++d)
+        tr += body.st.eps(i, d * Dim + d);
+      a[i] = v(i, 0);
+      b[i] = p.volume(i) * p.saturation(i) * tr;
+    }
+  }
+  EXPECT_LT(relative_difference(a, b), 1e-12) << "B~ u is V S_r tr(eps)";
+  // Force: p alone.
+  Kokkos::deep_copy(p.u, 0.0);
+  Kokkos::deep_copy(p.theta, 0.0);
+  fill(p, as_vectors(p.p), 3);
+  body.forces();
+  TpetraVector pv(body.disc.dist.owned_map()), f(dofs);
+  {
+    auto v = pv.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < p.n_owned; ++i)
+      v(i, 0) = p.p(i);
+  }
+  B->apply(pv, f, Teuchos::TRANS);
+  std::vector<double> fa, fb, la, lb;
+  auto v = f.getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    for (int d = 0; d < Dim; ++d) {
+      fa.push_back(v(i * NC + d, 0));
+      fb.push_back(p.volume(i) * body.st.force(i, d));
+    }
+    for (int r = 0; r < R; ++r) {
+      la.push_back(v(i * NC + Dim + r, 0));
+      lb.push_back(p.volume(i) * body.st.moment(i, r));
+    }
+  }
+  EXPECT_LT(relative_difference(fa, fb), 1e-12) << "B~^T p is the pore water's force";
+  EXPECT_LT(relative_difference(la, lb), 1e-10) << "and its moment";
+}
+
+TEST(PressureProjection, CouplingIsTheVolumetricStrainAndThePressureForce2D) {
+  check_coupling<2>();
+}
+TEST(PressureProjection, CouplingIsTheVolumetricStrainAndThePressureForce3D) {
+  check_coupling<3>();
+}
+
+}  // namespace
+}  // namespace mupm
