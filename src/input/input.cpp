@@ -471,17 +471,16 @@ RCP<ParameterList> valid_parameters() {
           "step (Pressure Solve) for the pressure at the step's end, with the volume change it "
           "gives the skeleton within the step (a pressure projection, include/mupm/solvers/"
           "pressure_projection.hpp): the step is the drained skeleton's, any K_w (Fluid->"
-          "Incompressible), no fluid substeps. Not yet with Fracture Flow.",
+          "Incompressible), no fluid substeps. Refused for now: Fracture Flow, mirrored Pore "
+          "Pressure layers and Fluid Flux, and Staggering, Solid Steps Per Fluid Step, Fluid "
+          "Substeps other than Solid First, 1, 1.",
           pressure_integration_options().validator());
     {
       ParameterList& ps = s.sublist(
           "Pressure Solve", false,
-          "The linear solve of Pressure Integration = Semi-Implicit (Trilinos: Belos, Ifpack2), "
+          "The linear solve of Pressure Integration = Semi-Implicit (Trilinos: Belos' GMRES, "
+          "Ifpack2), "
           "distributed over the ranks like the points.");
-      ps.set("Method", std::string("GMRES"),
-             "Belos' Krylov solver: GMRES, or CG (the system is symmetric only without mirrored "
-             "pressure layers and Fluid Flux conditions).",
-             one_of({"GMRES", "CG"}));
       ps.set("Preconditioner", std::string("ILU"),
              "Ifpack2's preconditioner: ILU (RILUK on each rank's rows), Jacobi or None.",
              one_of({"ILU", "Jacobi", "None"}));

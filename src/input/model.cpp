@@ -351,7 +351,6 @@ Model<Dim> model_from_input(const ParameterList& input) {
       PressureIntegration::SemiImplicit;
   {
     const ParameterList& ps = solver.sublist("Pressure Solve");
-    r.pressure_solve.method = ps.get<std::string>("Method");
     r.pressure_solve.preconditioner = ps.get<std::string>("Preconditioner");
     r.pressure_solve.fill_level = ps.get<int>("ILU Fill Level");
     r.pressure_solve.tolerance = ps.get<double>("Tolerance");

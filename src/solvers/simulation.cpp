@@ -339,9 +339,11 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   }
   if (ph.fluid && model.fracture.flow)
     ph.fluid->enable_fracture_flow(model.fracture);
-  if (ph.fluid && model.run.semi_implicit) {  // input/model.cpp: Hydro-Mechanical, a solid
+  if (ph.fluid && model.run.semi_implicit) {  // Hydro-Mechanical (src/input/input.cpp)
     ph.fluid->enable_semi_implicit(model.run.pressure_solve);
     ph.sequence.skeleton = dynamic_cast<Skeleton*>(ph.mechanics.get());
+    if (!ph.sequence.skeleton)
+      throw std::logic_error("Pressure Integration = Semi-Implicit without a solid skeleton");
   }
   ph.spacing = disc.grid.dx;
   ph.sequence.mechanics = ph.mechanics.get();
@@ -524,7 +526,7 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
     out << "mupm: pore fluid, semi-implicit pressure: k/mu_w = " << f.mobility
         << " m^2/(Pa s), K_w = " << f.bulk_modulus
         << " Pa, flow stabilization G = " << f.stabilization << "; one solve per step ("
-        << ls.method << ", " << ls.preconditioner << ", tolerance " << ls.tolerance << ")\n";
+        << "GMRES, " << ls.preconditioner << ", tolerance " << ls.tolerance << ")\n";
   }
   if (ph.fluid && !ph.fluid->semi_implicit()) {
     auto& fluid = *ph.fluid;

@@ -1,6 +1,8 @@
-// The semi-implicit pressure step (include/mupm/solvers/pressure_projection.hpp) and its
-// assembled operators (include/mupm/solvers/pressure_system.hpp): each matrix against the
-// kernels it stands for, then closed forms at the drained skeleton's step.
+// The assembled operators of the semi-implicit pressure step (include/mupm/solvers/
+// pressure_system.hpp) against the kernels they stand for, on 1 and 2 ranks: the flow operator
+// and the coupling (volumetric strain, pressure force and moment). The step itself is tested
+// against closed forms in tests/solvers/test_fluid_solver.cpp (FluidSolverSemiImplicit,
+// FluidSolverLong.TerzaghiSemiImplicit*) and tests/cli/semi_implicit.sh.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -286,15 +286,18 @@ class FluidSolver : public Module {
     if (fracture_)
       throw std::logic_error("FluidSolver: the semi-implicit pressure has no fracture flow yet");
     solve_settings_ = settings;
+    semi_implicit_ = true;
     const std::size_t n = disc_.points.n_owned;
     for (auto* v : {&dp_, &hdp_, &c_old_, &sr_old_, &flow_old_})
       *v = Scalars("mupm::projection_state", n);
   }
-  bool semi_implicit() const { return dp_.extent(0) > 0; }
+  // The same on every rank (a rank may own no point).
+  bool semi_implicit() const { return semi_implicit_; }
   struct SolveStats {
     double iterations = 0, residual = 0, assemblies = 0;
   };
-  // The last pressure solve's iterations and residual, and the assemblies so far.
+  // The last pressure solve's iterations and residual, and the assemblies since this run (or
+  // restart) began.
   SolveStats solve_stats() const { return stats_; }
 
   // Steps 2-3 of pressure_projection.hpp between the skeleton's move() and finish(): the new
@@ -636,7 +639,6 @@ class FluidSolver : public Module {
     }
   }
 
-  // One forward-Euler step from t to t + dt (eqs 141-146). evaluate() has run for the state at t.
   // Sources [1/s] at t into source_: rate g(t) (per metre of thickness in 2D) over the
   // region's volume; books the water they bring over dt.
   void sources(double t, double dt) {
@@ -660,6 +662,7 @@ class FluidSolver : public Module {
     }
   }
 
+  // One forward-Euler step from t to t + dt (eqs 141-146). evaluate() has run for the state at t.
   void substep(double t, double dt, double dt_total) {
     auto& p = disc_.points;
     auto regions = p.regions;
@@ -809,6 +812,7 @@ class FluidSolver : public Module {
   Scalars dp_, hdp_, c_old_, sr_old_, flow_old_;
   SolveStats stats_;
   double solve_scale_ = 0;
+  bool semi_implicit_ = false;
 };
 
 }  // namespace mupm

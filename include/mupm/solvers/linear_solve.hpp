@@ -1,5 +1,5 @@
 // A distributed sparse linear solve on Trilinos' stack: a Tpetra CrsMatrix over the points' map,
-// a Belos Krylov solver (GMRES, or CG for a symmetric positive definite matrix) and an Ifpack2
+// Belos' GMRES and an Ifpack2
 // preconditioner (ILU(k) by default, or Jacobi), built once per matrix and reused for every
 // right-hand side until the matrix changes (set_matrix). No rank ever holds more than its own
 // rows.
@@ -24,7 +24,6 @@ using CrsMatrix = Tpetra::CrsMatrix<double, LocalId, GlobalId>;
 using TpetraVector = Tpetra::Vector<double, LocalId, GlobalId>;
 
 struct LinearSolveSettings {
-  std::string method = "GMRES";        // "GMRES" | "CG"
   std::string preconditioner = "ILU";  // "ILU" (Ifpack2 RILUK) | "Jacobi" | "None"
   int fill_level = 0;                  // ILU(k)
   double tolerance = 1e-10;            // ||b - A x|| / the largest ||b|| so far

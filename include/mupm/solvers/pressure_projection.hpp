@@ -107,7 +107,7 @@ class PressureProjection {
     ScopedRegion region("mupm::Pressure::projection");
     auto& p = disc_.points;
     const std::size_t n = p.n_owned;
-    if (needs_assembly(dt, sk))
+    if (needs_assembly(dt, st, sk))
       assemble(dt, prm, st, sk);
     const auto& owned = disc_.dist.owned_map();
     TpetraVector du(dofs_), b(owned), c(owned), ac(owned), x(owned), y(owned);
@@ -196,14 +196,15 @@ class PressureProjection {
 
  private:
   // The state the matrix depends on, besides the bonds (invalidate): dt, S_r, k_r, C, rho, J.
-  bool needs_assembly(double dt, const SkeletonState& sk) {
+  static constexpr std::size_t kSeen = 5;
+  bool needs_assembly(double dt, const FluidState<Dim>& st, const SkeletonState& sk) {
     const auto& p = disc_.points;
     const std::size_t n = p.n_owned;
     int changed = stale_ || dt != dt_ ? 1 : 0;
-    if (!changed && seen_.size() == 4 * n)
-      for (std::size_t i = 0; i < n && !changed; ++i)
-        changed = seen_[4 * i] != p.saturation(i) || seen_[4 * i + 1] != p.rel_perm(i) ||
-                  seen_[4 * i + 2] != sk.density(i) || seen_[4 * i + 3] != sk.inertia(i);
+    for (std::size_t i = 0; i < n && !changed; ++i)
+      changed = seen_[kSeen * i] != p.saturation(i) || seen_[kSeen * i + 1] != p.rel_perm(i) ||
+                seen_[kSeen * i + 2] != sk.density(i) || seen_[kSeen * i + 3] != sk.inertia(i) ||
+                seen_[kSeen * i + 4] != st.storage(i);
     MPI_Allreduce(MPI_IN_PLACE, &changed, 1, MPI_INT, MPI_MAX, comm_);
     return changed != 0;
   }
@@ -214,12 +215,13 @@ class PressureProjection {
     auto& p = disc_.points;
     const std::size_t n = p.n_owned;
     const auto& owned = disc_.dist.owned_map();
-    seen_.resize(4 * n);
+    seen_.resize(kSeen * n);
     for (std::size_t i = 0; i < n; ++i) {
-      seen_[4 * i] = p.saturation(i);
-      seen_[4 * i + 1] = p.rel_perm(i);
-      seen_[4 * i + 2] = sk.density(i);
-      seen_[4 * i + 3] = sk.inertia(i);
+      seen_[kSeen * i] = p.saturation(i);
+      seen_[kSeen * i + 1] = p.rel_perm(i);
+      seen_[kSeen * i + 2] = sk.density(i);
+      seen_[kSeen * i + 3] = sk.inertia(i);
+      seen_[kSeen * i + 4] = st.storage(i);
     }
     flow_ = assemble_flow_operator(disc_, prm, st);
     coupling_ = assemble_volume_coupling(disc_);
