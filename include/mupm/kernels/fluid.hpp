@@ -109,6 +109,18 @@ KOKKOS_INLINE_FUNCTION double stored_energy_density(const VanGenuchten& vg, doub
   return 0.5 * p * s;  // int_0^p f dq = (p/2) sum_k w_k f(q_k), q_k the nodes on [p, 0]
 }
 
+// The pressure at which the stored energy takes in water that enters at a point (a source or
+// a reservoir) over a step from p0 by dp with storage C: [psi(p0 + dp) - psi(p0)] / (C dp), the
+// step's mean pressure p0 + dp/2 when C is constant (and when nothing enters, `enters` false).
+KOKKOS_INLINE_FUNCTION double entry_pressure(const VanGenuchten& vg, double phi, double inv_kw,
+                                             double p0, double dp, double C, bool enters) {
+  if (!enters || C * dp == 0)
+    return p0 + 0.5 * dp;
+  return (stored_energy_density(vg, phi, inv_kw, p0 + dp) -
+          stored_energy_density(vg, phi, inv_kw, p0)) /
+         (C * dp);
+}
+
 // Saturation (eq 12), relative permeability (eq 56), storage C and the undrained modulus
 // S_r / C (for the solid's undrained split, include/mupm/kernels/solid.hpp) of the owned points.
 template <int Dim>

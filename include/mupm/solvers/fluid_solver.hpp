@@ -359,11 +359,7 @@ class FluidSolver : public Module {
           const bool held = fixed(i) & kFixedPressure;
           target(i) = held ? vol(i) * (C(i) * dp - rhs) : 0.0;  // the reservoir's water [m^3]
           const double pm = p0 + 0.5 * dp;
-          double pe = pm;  // as in substep(): the pressure at which the storage takes water in
-          if ((src(i) != 0 || held) && C(i) * dp != 0)
-            pe = (stored_energy_density(vg, phi(i), inv_kw, p0 + dp) -
-                  stored_energy_density(vg, phi(i), inv_kw, p0)) /
-                 (C(i) * dp);
+          const double pe = entry_pressure(vg, phi(i), inv_kw, p0, dp, C(i), src(i) != 0 || held);
           wc += vol(i) * pm * sr(i) * dv;
           wd += vol(i) * pm * dt * flow;
           we += vol(i) * pe * dt * src(i) + pe * target(i);
@@ -722,12 +718,9 @@ class FluidSolver : public Module {
             }
             const double pm = p0 + 0.5 * dp;  // the step's mean pressure
             // Where water comes in or out (sources, reservoirs): the pressure at which the stored
-            // energy takes it, [psi(p0 + dp) - psi(p0)] / (C dp) (pm when C is constant).
-            double pe = pm;
-            if ((src(i) != 0 || (fixed(i) & kFixedPressure)) && C(i) * dp != 0)
-              pe = (stored_energy_density(vg, phi(i), inv_kw, p0 + dp) -
-                    stored_energy_density(vg, phi(i), inv_kw, p0)) /
-                   (C(i) * dp);
+            // energy takes it (pm when C is constant).
+            const double pe = entry_pressure(vg, phi(i), inv_kw, p0, dp, C(i),
+                                             src(i) != 0 || (fixed(i) & kFixedPressure));
             wc += vol(i) * pm * sr(i) * dv;
             wd += vol(i) * p0 * dt * flow(i);
             we += vol(i) * pe * dt * src(i) + pe * target(i);
