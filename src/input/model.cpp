@@ -421,6 +421,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
                              ? std::numeric_limits<double>::infinity()
                              : fluid.get<double>("Fluid Bulk Modulus");
   m.fluid.semi_implicit = r.semi_implicit;
+  m.fluid.projection_stabilization = solver.get<double>("Pressure Stabilization");
   if (retention_model_options()(fluid.get<std::string>("Retention Model")) ==
       RetentionModel::VanGenuchten) {
     m.fluid.retention = VanGenuchten::mualem(fluid.get<double>("Air Entry Pressure"),

@@ -7,6 +7,7 @@
 #include <Teuchos_ParameterList.hpp>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "mupm/core/timers.hpp"
@@ -102,9 +103,18 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
   if (!impl_->problem->setProblem())
     throw std::logic_error("LinearSolve: Belos could not set up the problem");
   impl_->solver->setProblem(impl_->problem);
-  r.converged = impl_->solver->solve() == Belos::Converged;
-  r.iterations = impl_->solver->getNumIters();
-  r.residual = impl_->solver->achievedTol() * bn / scale;
+  // Belos throws when its residual turns NaN (a singular preconditioner, a matrix gone
+  // non-finite); the same on every rank (its norms are global): a failed solve, for the caller
+  // to report.
+  try {
+    r.converged = impl_->solver->solve() == Belos::Converged;
+    r.iterations = impl_->solver->getNumIters();
+    r.residual = impl_->solver->achievedTol() * bn / scale;
+  } catch (const std::exception&) {
+    r.converged = false;
+    r.iterations = impl_->solver->getNumIters();
+    r.residual = std::numeric_limits<double>::quiet_NaN();
+  }
   return r;
 }
 

@@ -78,8 +78,8 @@ base '' "$si" >si_solid.xml
 expect si_solid 2 'mupm->Solver->Pressure Integration = Semi-Implicit' 'Physics = Hydro-Mechanical'
 base '' "$hm$si" | sed -e "s|<ParameterList name=\"Solver\">|<ParameterList name=\"Fracture\"><Parameter name=\"Fracture Flow\" type=\"bool\" value=\"true\"/></ParameterList>$fluid&|" -e "s|<Parameter name=\"Bulk Modulus\"|$pores&|" >si_fracture_flow.xml
 expect si_fracture_flow 2 'mupm->Solver->Pressure Integration = Semi-Implicit' 'Fracture->Fracture Flow must be false'
-sed -e 's|<Parameter name="Type" type="string" value="Pore Pressure"/>|&<Parameter name="Boundary Layer Values" type="string" value="Mirrored"/>|' straight.xml >si_mirrored.xml
-grep -q 'value="Mirrored"' si_mirrored.xml || fail "si_mirrored.xml not derived"
-expect si_mirrored 2 'mupm->Solver->Pressure Integration = Semi-Implicit does not take mupm->Boundary Conditions->' '->Boundary Layer Values = Mirrored yet'
-expect_dir si_mirrored_validate 'Boundary Layer Values = Mirrored yet' --validate si_mirrored.xml
+sed -e 's|<Parameter name="Type" type="string" value="Pore Pressure"/>|<Parameter name="Type" type="string" value="Fluid Flux"/>|' straight.xml >si_flux.xml
+grep -q 'value="Fluid Flux"' si_flux.xml || fail "si_flux.xml not derived"
+expect si_flux 2 'mupm->Solver->Pressure Integration = Semi-Implicit does not take mupm->Boundary Conditions->' '->Type = Fluid Flux yet'
+expect_dir si_flux_validate 'Type = Fluid Flux yet' --validate si_flux.xml
 echo "semi_implicit: all checks passed"

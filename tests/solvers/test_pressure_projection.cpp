@@ -71,7 +71,7 @@ void check_flow_operator() {
   Scalars x("x", p.size());
   fill(p, as_vectors(x), 5);
   fluid_flow(disc, fp, st, x, false);
-  const auto H = assemble_flow_operator(disc, fp, st);
+  const auto H = assemble_flow_operator(disc, fp, st.alpha);
   TpetraVector xv(disc.dist.owned_map()), y(disc.dist.owned_map());
   {
     auto v = xv.getLocalViewHost(Tpetra::Access::OverwriteAll);
@@ -187,6 +187,111 @@ TEST(PressureProjection, CouplingIsTheVolumetricStrainAndThePressureForce2D) {
 }
 TEST(PressureProjection, CouplingIsTheVolumetricStrainAndThePressureForce3D) {
   check_coupling<3>();
+}
+
+// The pressure stabilization (pressure_projection.hpp): a checkerboard pressure exerts no force
+// on the skeleton at the points whose neighbours' families are whole (B~^T p = 0: the
+// projection cannot see it), and the stabilized flow operator holds it with the closed form of
+// the header: with k = 0 and grad p = 0 on the whole families, (V H p)_i = 2 alpha V_i
+// sum_j V_j (p_i - p_j) = 4 alpha V_i p_i sum_{j odd} V_j, alpha = G_p S_r^2 dt / (rho k2 w0), k2
+// the continuous family's second moment, pi h delta^4 / 4 (2D) or 4 pi delta^5 / 15 (3D).
+template <int Dim>
+void check_checkerboard() {
+  constexpr int R = kRotDim<Dim>, NC = Dim + R;
+  std::array<long long, Dim> counts;
+  counts.fill(Dim == 2 ? 18 : 15);
+  const auto law = MicropolarElastic::from_bulk_shear(10e6, 6e6, 3e6, 0.01);
+  const double rho = 1900, dt = 3e-6, Gp = 0.7;
+  test::Body<Dim> body(test::box<Dim>(counts, 3.015), law, 0.5, StabilizationModulus::Automatic,
+                       rho);
+  auto& disc = body.disc;
+  auto& p = disc.points;
+  const double dx = disc.grid.dx, delta = disc.grid.horizon, L = counts[0] * dx;
+  Kokkos::deep_copy(p.saturation, 1.0);
+  auto parity = [&](std::size_t i) {
+    long long s = 0;
+    for (int d = 0; d < Dim; ++d)
+      s += (long long)std::floor(p.x(i, d) / dx);
+    return s % 2 == 0 ? 1.0 : -1.0;
+  };
+  auto interior = [&](std::size_t i) {  // at least 2 delta from every face
+    for (int d = 0; d < Dim; ++d)
+      if (p.x(i, d) < 2 * delta || p.x(i, d) > L - 2 * delta)
+        return false;
+    return true;
+  };
+  const auto& owned = disc.dist.owned_map();
+  TpetraVector cb(owned), single(owned), out(owned);
+  {
+    auto v = cb.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    auto w = single.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      v(i, 0) = parity(i);
+      w(i, 0) = interior(i) ? 1.0 : 0.0;  // unit pressures: the scale of a force
+    }
+  }
+  const auto B = assemble_volume_coupling(disc);
+  const auto dofs = component_map(disc, NC, false);
+  TpetraVector f(dofs), fs(dofs);
+  B->apply(cb, f, Teuchos::TRANS);
+  B->apply(single, fs, Teuchos::TRANS);
+  // The stabilized operator without flow (k = 0: the flow's own alpha is zero).
+  auto fp = fluid_params(disc.grid, 0.0, 0.5);
+  fp.projection_stabilization = Gp;
+  Scalars alpha("alpha", p.size()), density("rho", p.n_owned);
+  Kokkos::deep_copy(density, rho);
+  add_pressure_stabilization(disc, fp, dt, density, alpha);
+  assemble_flow_operator(disc, fp, alpha)->apply(cb, out);
+  const double k2 = Dim == 2 ? kPi * disc.grid.thickness * std::pow(delta, 4) / 4
+                             : 4 * kPi * std::pow(delta, 5) / 15;
+  const double a = Gp * dt / (rho * k2);
+  // w0 = (the family's volume) / V_H, V_H the continuous family's: pi delta^2 h or 4 pi delta^3 / 3
+  // (eq 76; the same on every whole family).
+  const double vh =
+      Dim == 2 ? kPi * delta * delta * disc.grid.thickness : 4 * kPi * std::pow(delta, 3) / 3;
+  double force = 0, scale = 0, worst = 0, held = 0;
+  long long n = 0;
+  auto fv = f.getLocalViewHost(Tpetra::Access::ReadOnly);
+  auto sv = fs.getLocalViewHost(Tpetra::Access::ReadOnly);
+  auto ov = out.getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    for (int k = 0; k < Dim; ++k)
+      scale = std::max(scale, std::abs(sv(i * NC + k, 0)));
+    if (!interior(i))
+      continue;
+    ++n;
+    for (int k = 0; k < NC; ++k)
+      force = std::max(force, std::abs(fv(i * NC + k, 0)));
+    double odd = 0, family = 0;
+    for (BondIndex e = disc.bonds.offsets(i); e < disc.bonds.offsets(i + 1); ++e) {
+      family += p.volume(disc.bonds.neighbor(e));
+      if (parity(disc.bonds.neighbor(e)) != parity(i))
+        odd += p.volume(disc.bonds.neighbor(e));
+    }
+    const double expected = 4 * a / (family / vh) * p.volume(i) * parity(i) * odd;
+    held = std::max(held, std::abs(expected));
+    worst = std::max(worst, std::abs(ov(i, 0) - expected));
+  }
+  force = global_max(force);
+  scale = global_max(scale);
+  worst = global_max(worst);
+  held = global_max(held);
+  if (test::world()->getRank() == 0)
+    std::printf(
+        "[ checkerboard ] %dD: force %.2e of a unit pressure's %.2e; stabilized operator "
+        "%.3e, off the closed form by %.2e\n",
+        Dim, force, scale, held, worst);
+  EXPECT_GT(global_max(double(n)), 0) << "no interior point";
+  EXPECT_LT(force, 1e-12 * scale) << "the skeleton feels the checkerboard";
+  EXPECT_GT(held, 0);
+  EXPECT_LT(worst, 1e-12 * held);
+}
+
+TEST(PressureProjection, CheckerboardIsHeldByThePressureStabilization2D) {
+  check_checkerboard<2>();
+}
+TEST(PressureProjection, CheckerboardIsHeldByThePressureStabilization3D) {
+  check_checkerboard<3>();
 }
 
 }  // namespace

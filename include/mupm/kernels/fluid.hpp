@@ -64,6 +64,9 @@ struct FluidParams {
   // Solver->Pressure Integration = Semi-Implicit (include/mupm/solvers/pressure_projection.hpp):
   // the solid sees p itself, no undrained split (Points::undrained_modulus = 0).
   bool semi_implicit = false;
+  // G_p of the projection's pressure stabilization (Semi-Implicit only; include/mupm/solvers/
+  // pressure_projection.hpp).
+  double projection_stabilization = 1.0;
   double horizon_volume = 0;           // V_H: volume of a full continuous family
   double second_moment = 0;            // k2 = int_H |xi|^2 / Dim dV
   Kokkos::Array<double, 3> gravity{};  // g in Darcy's law (all zero: no gravity term)

@@ -324,6 +324,11 @@ class FluidSolver : public Module {
         << r.residual << " after " << r.iterations
         << " iterations (mupm->Solver->Pressure Solve: Tolerance, Maximum Iterations, "
            "Preconditioner)";
+      // Measured: ILU(0) broke down (a zero pivot, NaN residual) on Example 1 case 2 with
+      // incompressible water once the crack grew; Jacobi carried the run on (inputs/README.md).
+      if (std::isnan(r.residual))
+        m << "; a NaN residual: the preconditioner broke down (ILU(k) can meet a zero pivot on "
+             "this matrix), mupm->Solver->Pressure Solve->Preconditioner = Jacobi avoids it";
       throw CollectiveError(m.str());
     }
     skeleton.add_projection_work(r.work);

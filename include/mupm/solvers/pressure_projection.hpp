@@ -41,8 +41,10 @@
 // pressure's impulse at first order (the projection work below is negative). This is the
 // argument, not a proof for the nonlocal operators; measured: stable at 0.5 of the drained
 // estimate in every test (tests/solvers/test_fluid_solver.cpp, FluidSolverSemiImplicit and
-// FluidSolverLong.TerzaghiSemiImplicit*, tests/cli/semi_implicit.sh), and unstable at any step
-// tried (0.1 to 0.5 of it) with mirrored pressure layers and stiff water, which the input
+// FluidSolverLong.TerzaghiSemiImplicit*, tests/cli/semi_implicit.sh). Without the pressure
+// stabilization below, mirrored pressure layers with stiff or incompressible water were
+// unstable at any step tried (0.1 to 0.5 of it); with it they run (Terzaghi within 1 %), but a
+// Fluid Flux layer (an even image) with incompressible water still diverges, which the input
 // refuses (src/input/input.cpp, check_pressure_integration).
 //
 // What it conserves. Water: each free point's balance holds to the linear solve's tolerance;
@@ -56,6 +58,33 @@
 // work, negative where the pressure resists the volume change (what the projection
 // dissipates, reported as projection_work). The fluid's balance books the same trapezoid as
 // its coupling work.
+//
+// Pressure stabilization (Solver->Pressure Stabilization, G_p). On a regular grid the
+// checkerboard p_i = (-1)^(i_x) (and its y, z and diagonal kin) has a zero nonlocal gradient at
+// every interior point: sum_j omega (p_j - p_i) xi V_j pairs the bond xi with -xi, whose
+// pressure differences are equal, so the terms cancel (eq 59); by the same pairing B~^T p, the
+// pore water's force, vanishes. B~ M^-1 B~^T is blind to these modes, and with C = 0 only the
+// flow holds them, through its stabilization alpha (eqs 72-78), which scales with k. In a tight
+// soil dt V H is negligible against dt^2 B~ M^-1 B~^T (Example 1: k / mu_w = 2.8e-13 against
+// dt / rho = 1.7e-9 in m^3 s/kg): the system is singular to round-off and GMRES stalls
+// (measured: relative residual 0.22 after 1000 iterations). The remedy is the flow
+// stabilization itself with a mobility of the projection's scale, on the increment only:
+// every point's alpha_i gets
+//   alpha_p,i = G_p S_r,i^2 dt / (rho_i k2 w0_i)   (eq 76's with lambda -> G_p S_r^2 dt / rho),
+// in the matrix's flow operator (not in the right-hand side's div(p_n)). Why that mobility: for
+// a smooth field B~ M^-1 B~^T -> -V div((S_r^2 / rho) grad), so dt^2 times it is a flow term
+// dt V H with lambda = S_r^2 dt / rho; the stabilization then holds the modes the projection
+// misses as strongly as the projection holds those it sees (G_p ~ 1), in the spirit of
+// Brezzi and Pitkaranta's pressure stabilization, with tau ~ dt^2 / rho ~ dx^2 / M at the
+// skeleton's step. What it changes: it acts on the non-uniform part R of the increment only
+// (zero for linear increments, and for quadratic ones where alpha is uniform,
+// kernels/fluid.hpp), so smooth consolidation is left alone (Terzaghi's incompressible column,
+// k / mu_w = 5.2e-9: the same U and p to 4 digits with G_p = 0 and 1); per step it moves
+// dt V S dp of water between neighbours, O(dt^2 dp): a flux, summing to zero over the body
+// (S 1 = 0), booked with the flow (its part of the fluid's dissipation). The incompressible
+// constraint B~ (u_{n+1} - u_n) = 0 becomes = -dt V S dp: a compressibility at the horizon's
+// scale that vanishes as dt^2. It keeps A symmetric positive semi-definite (S is a sum of
+// squares: sum_i alpha_i V_i sum_j V_j R_ij^2).
 //
 // The matrix and its preconditioner are kept while the bonds, the time step, the saturation,
 // the relative permeability and the densities are unchanged (a saturated run without breakage
@@ -131,23 +160,22 @@ class PressureProjection {
     {
       auto cv = c.getLocalViewHost(Tpetra::Access::OverwriteAll);
       for (std::size_t i = 0; i < n; ++i)
-        cv(i, 0) = roles_[i] == PressureRole::Free ? 0.0 : target(i) - p.p(i);
+        cv(i, 0) = roles_[i] == PressureRole::Free ? 0.0 : target(i) - p.p(i);  // 0: isolated
     }
     full_->apply(c, ac);
     {
       auto bv = b.getLocalViewHost(Tpetra::Access::ReadWrite);
       auto av = ac.getLocalViewHost(Tpetra::Access::ReadOnly);
       for (std::size_t i = 0; i < n; ++i)
-        bv(i, 0) = roles_[i] == PressureRole::Free
-                       ? -bv(i, 0) + dt * p.volume(i) * (source(i) - st.flow(i)) - av(i, 0)
-                       : 0.0;
+        bv(i, 0) =
+            solved_[i] ? -bv(i, 0) + dt * p.volume(i) * (source(i) - st.flow(i)) - av(i, 0) : 0.0;
     }
     // The previous step's increment (p_rate dt, checkpointed: a restart starts the same
     // iteration) starts the iteration: the increments change smoothly.
     {
       auto xv = x.getLocalViewHost(Tpetra::Access::OverwriteAll);
       for (std::size_t i = 0; i < n; ++i)
-        xv(i, 0) = roles_[i] == PressureRole::Free ? p.p_rate(i) * dt : 0.0;
+        xv(i, 0) = solved_[i] ? p.p_rate(i) * dt : 0.0;
     }
     Result r;
     const auto res = solver_.solve(b, x, scale);
@@ -230,7 +258,11 @@ class PressureProjection {
       seen_[kSeen * i + 3] = sk.inertia(i);
       seen_[kSeen * i + 4] = st.storage(i);
     }
-    flow_ = assemble_flow_operator(disc_, prm, st);
+    // The flow operator with the pressure stabilization added to the flow's (header).
+    Scalars alpha("mupm::projection_alpha", p.size());
+    Kokkos::deep_copy(alpha, st.alpha);
+    add_pressure_stabilization(disc_, prm, dt, sk.density, alpha);
+    flow_ = assemble_flow_operator(disc_, prm, alpha);
     coupling_ = assemble_volume_coupling(disc_);
     inverse_mass_ = Teuchos::rcp(new TpetraVector(dofs_));
     TpetraVector storage(owned);
@@ -254,27 +286,32 @@ class PressureProjection {
     // increments). S_H: the images follow their mirrors' increments (odd or even), for the flow;
     // S_P: they do not, for the skeleton's response within the step. An image's pressure reaches
     // the skeleton in the next step's forces, as a held pressure does (measured: with the
-    // images' increments in the projection too, Terzaghi's mirrored column with incompressible
-    // or stiff water (K_w / phi = 100 M) and slow consolidation grew without bound: the image's
-    // force on the layer's skeleton, -p(mirror), answers the body's compression within the same
-    // solve, a coupling no water balance books). The system is R (dt V H S_H + (dt^2 P + V C) S_P)
-    // + D_c: R keeps the free rows, D_c puts the mean free diagonal on the others.
+    // images' increments in the projection too (before the pressure stabilization), Terzaghi's
+    // mirrored column with incompressible or stiff water (K_w / phi = 100 M) and slow consolidation
+    // grew without bound: the image's force on the layer's skeleton, -p(mirror), answers the body's
+    // compression within the same solve, a coupling no water balance books). The system is
+    // R (dt V H S_H + (dt^2 P + V C) S_P) + D_c: R keeps the free rows, D_c puts the mean free
+    // diagonal on the others.
     std::vector<std::vector<std::pair<LocalId, double>>> rows(n), free_rows(n);
     TpetraVector keep(owned), diag(owned), other(owned);
     full_->getLocalDiagCopy(diag);
+    // A free point whose row is empty (it lost all its bonds, and its water has no storage:
+    // incompressible) keeps its pressure: dp = 0, a row of the mean diagonal.
     double sum[2] = {0, 0};
+    solved_.assign(n, 0);
     {
       auto kv = keep.getLocalViewHost(Tpetra::Access::OverwriteAll);
       auto dv = diag.getLocalViewHost(Tpetra::Access::ReadOnly);
       for (std::size_t i = 0; i < n; ++i) {
-        const bool free = roles_[i] == PressureRole::Free;
+        const bool free = roles_[i] == PressureRole::Free && dv(i, 0) > 0;
+        solved_[i] = free ? 1 : 0;
         kv(i, 0) = free ? 1.0 : 0.0;
         if (free) {
           rows[i].push_back({LocalId(i), 1.0});
           free_rows[i].push_back({LocalId(i), 1.0});
           sum[0] += dv(i, 0);
           sum[1] += 1;
-        } else if (roles_[i] != PressureRole::Held) {
+        } else if (roles_[i] == PressureRole::OddImage || roles_[i] == PressureRole::EvenImage) {
           rows[i].push_back({images_[i], roles_[i] == PressureRole::OddImage ? -1.0 : 1.0});
         }
       }
@@ -284,7 +321,7 @@ class PressureProjection {
     {
       auto ov = other.getLocalViewHost(Tpetra::Access::OverwriteAll);
       for (std::size_t i = 0; i < n; ++i)
-        ov(i, 0) = roles_[i] == PressureRole::Free ? 0.0 : mean;
+        ov(i, 0) = solved_[i] ? 0.0 : mean;
     }
     images_matrix_ = detail::from_rows(owned, disc_.dist.overlap_map(), owned, owned, rows);
     free_matrix_ = detail::from_rows(owned, owned, owned, owned, free_rows);
@@ -305,6 +342,7 @@ class PressureProjection {
   LinearSolve solver_;
   std::vector<PressureRole> roles_;
   std::vector<LocalId> images_;
+  std::vector<char> solved_;  // the free rows the last assembly kept
   MPI_Comm comm_;
   Teuchos::RCP<const Map> dofs_;
   Teuchos::RCP<CrsMatrix> flow_, coupling_, full_, images_matrix_, free_matrix_, system_;

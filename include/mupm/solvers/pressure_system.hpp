@@ -90,11 +90,12 @@ inline Teuchos::RCP<CrsMatrix> from_rows(
 }
 }  // namespace detail
 
-// V H (header, 1): the fluid's state (alpha on the ghosts, k_r) must be that of the last
-// evaluation, as after FluidSolver's evaluate().
+// V H (header, 1) with the stabilization coefficients `alpha` (owned + ghosts: the fluid
+// state's alpha after FluidSolver's evaluate(), or more, pressure_projection.hpp) and the
+// points' current k_r.
 template <int Dim>
 Teuchos::RCP<CrsMatrix> assemble_flow_operator(const Discretization<Dim>& disc,
-                                               const FluidParams& prm, const FluidState<Dim>& st) {
+                                               const FluidParams& prm, const Scalars& alpha) {
   const auto& p = disc.points;
   const auto& b = disc.bonds;
   const auto& sh = disc.shape;
@@ -104,7 +105,7 @@ Teuchos::RCP<CrsMatrix> assemble_flow_operator(const Discretization<Dim>& disc,
   const std::size_t n = p.n_owned;
   std::vector<std::vector<std::pair<LocalId, double>>> gr(n * Dim), wgr(n * Dim), lap(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double vi = p.volume(i), ai = st.alpha(i);
+    const double vi = p.volume(i), ai = alpha(i);
     double self_lap = 0;
     const bool singular = sh.singular(i) != 0;
     double Kinv[Dim * Dim], K[Dim * Dim], W[Dim * Dim];
@@ -117,7 +118,7 @@ Teuchos::RCP<CrsMatrix> assemble_flow_operator(const Discretization<Dim>& disc,
         continue;
       const LocalId j = b.neighbor(e);
       const double vj = p.volume(j);
-      const double w = vi * vj * (ai + st.alpha(j));
+      const double w = vi * vj * (ai + alpha(j));
       lap[i].push_back({j, -w});
       self_lap += w;
       if (singular)
@@ -161,6 +162,22 @@ Teuchos::RCP<CrsMatrix> assemble_flow_operator(const Discretization<Dim>& disc,
   auto flux = Teuchos::rcp(new CrsMatrix(owned, 0));
   Tpetra::MatrixMatrix::Multiply(*G, true, *WG, false, *flux);
   return Tpetra::MatrixMatrix::add(1.0, false, *flux, 1.0, false, *L);
+}
+
+// The pressure stabilization of the semi-implicit step (derivation in pressure_projection.hpp):
+// alpha_i += G_p S_r,i^2 dt / (rho_i k2 w0_i) on the owned points, w0_i = omega_0,i / V_H (eq 76),
+// rho the lumped mass density; then the ghosts are refreshed (collective).
+template <int Dim>
+void add_pressure_stabilization(Discretization<Dim>& disc, const FluidParams& prm, double dt,
+                                const Scalars& density, const Scalars& alpha) {
+  const auto& p = disc.points;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const double w0 = disc.shape.family_volume(i) / prm.horizon_volume, s = p.saturation(i);
+    const double rho = density(i);
+    if (w0 > 0 && rho > 0)
+      alpha(i) += prm.projection_stabilization * s * s * dt / (rho * prm.second_moment * w0);
+  }
+  disc.dist.refresh({as_vectors(alpha)});
 }
 
 // B~ (header, 2), over the owned points (rows) and their (u, theta) components (columns:
