@@ -1245,23 +1245,15 @@ static void check_pressure_integration(const ParameterList& input) {
   // (odd images) run since the pressure stabilization (pressure_projection.hpp): the same input
   // with drains, K_h / 10 and / 100, closes its balances (solid 1e-6 J, water 5e-13 kg), and
   // Terzaghi's mirrored column is within 1 % (tests/solvers/test_fluid_solver.cpp).
-  if (input.isSublist("Boundary Conditions")) {
-    auto text = [](const ParameterList& l, const char* name, const char* otherwise) {
-      return l.isParameter(name) ? l.get<std::string>(name) : std::string(otherwise);
-    };
-    for (auto it = input.sublist("Boundary Conditions").begin();
-         it != input.sublist("Boundary Conditions").end(); ++it) {
-      const auto& e = input.sublist("Boundary Conditions").entry(it);
-      if (!e.isList())
-        continue;
-      const ParameterList& c = Teuchos::getValue<ParameterList>(e);
-      if (text(c, "Type", "") == "Fluid Flux")
+  if (input.isSublist("Boundary Conditions")) {  // validated: every entry a sublist with a Type
+    const ParameterList& bcs = input.sublist("Boundary Conditions");
+    for (auto it = bcs.begin(); it != bcs.end(); ++it)
+      if (bcs.sublist(bcs.name(it)).get<std::string>("Type") == "Fluid Flux")
         throw InputError("Error, " + have + "does not take " + root + "->Boundary Conditions->" +
-                         it->first +
+                         bcs.name(it) +
                          "->Type = Fluid Flux yet: its layer's pressures, images of the body's, "
                          "were measured unstable with incompressible water. Use a Pore Pressure, "
                          "or Explicit.");
-    }
   }
   if (staggering_options()(solver.get<std::string>("Staggering")) != Staggering::SolidFirst ||
       solver.get<int>("Solid Steps Per Fluid Step") != 1 || solver.get<int>("Fluid Substeps") != 1)

@@ -439,6 +439,16 @@ struct ColumnRun {
   double time() const { return step * dt; }
 };
 
+// max |p_a - p_b| over the points of two runs of the same column (all ranks).
+double max_pressure_difference(const ColumnRun& a, const ColumnRun& b) {
+  auto pa = Kokkos::create_mirror_view_and_copy(HostSpace(), a.disc.points.p);
+  auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), b.disc.points.p);
+  double d = 0;
+  for (std::size_t i = 0; i < a.disc.points.n_owned; ++i)
+    d = std::max(d, std::abs(pa(i) - pb(i)));
+  return global_max(d);
+}
+
 // The boundary-layer drained condition (p = 0 on the layer points, the paper's method) puts
 // a kink in p at the face that the nonlocal gradient smears over the horizon: the face drains
 // as if about 2.3 dx farther away, an error of first order in delta/H (measured: the error
@@ -608,7 +618,7 @@ TEST(FluidSolverLong, TerzaghiSemiImplicitIncompressible) {
 }
 
 // Incompressible water in a tight soil (the column's consolidation 1e7 times slower than its
-// drained wave, k / mu_w = 1.3e-14 m^2/(Pa s)): undrained, the water takes the load (p = q
+// drained wave, k / mu_w = 2.9e-14 m^2/(Pa s)): undrained, the water takes the load (p = q
 // beyond the drains' reach). The pressure modes the skeleton does not feel are held by the
 // pressure stabilization (pressure_projection.hpp) alone: without it (G_p = 0) the first
 // solve stalls, or the modes fill the field. Shortly after the ramp the mean pressure beyond 5 dx
@@ -644,19 +654,18 @@ TEST(FluidSolverSemiImplicit, TightSoilIncompressibleTakesTheLoad) {
     Terzaghi bare = tz;
     bare.Gp = 0;
     ColumnRun run(bare, bare.N, false, 0.5, true, false, true);
-    bool failed = false;
+    bool stalled = false;
     try {
       run.run_to(1.5 * bare.t_r);
       measure(run, mean, worst);
-      failed = !(worst < 0.1);
     } catch (const CollectiveError&) {
-      failed = true;
+      stalled = true;
     }
     if (test::world()->getRank() == 0)
-      std::printf("[ tight soil ] G_p = 0: %s\n",
-                  failed && !(worst > 0) ? "the solve stalled"
-                                         : ("max |p/q - 1| = " + std::to_string(worst)).c_str());
-    EXPECT_TRUE(failed) << "stable without stabilization";
+      std::printf(
+          "[ tight soil ] G_p = 0: %s\n",
+          stalled ? "the solve stalled" : ("max |p/q - 1| = " + std::to_string(worst)).c_str());
+    EXPECT_TRUE(stalled || !(worst < 0.1)) << "stable without stabilization";
   }
   ColumnRun run(tz, tz.N, false, 0.5, true, false, true);
   run.run_to(1.5 * tz.t_r);
@@ -763,12 +772,7 @@ TEST(FluidSolverSemiImplicit, AgreesWithExplicitAsDtShrinks) {
     ex.run_to(t_end);
     si.run_to(t_end);
     ASSERT_EQ(ex.step, si.step);
-    auto pa = Kokkos::create_mirror_view_and_copy(HostSpace(), ex.disc.points.p);
-    auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), si.disc.points.p);
-    double d = 0;
-    for (std::size_t i = 0; i < ex.disc.points.n_owned; ++i)
-      d = std::max(d, std::abs(pa(i) - pb(i)));
-    diff[k] = global_max(d) / tz.p0;
+    diff[k] = max_pressure_difference(ex, si) / tz.p0;
     double drained = 0;
     for (double v : si.fluid->inflows())
       drained += v;
@@ -797,12 +801,7 @@ TEST(FluidSolverHydroMechanical, StaggeringOrdersAgreeAsDtShrinks) {
     a.run_to(t_end);
     b.run_to(t_end);
     ASSERT_EQ(a.step, b.step);
-    auto pa = Kokkos::create_mirror_view_and_copy(HostSpace(), a.disc.points.p);
-    auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), b.disc.points.p);
-    double d = 0;
-    for (std::size_t i = 0; i < a.disc.points.n_owned; ++i)
-      d = std::max(d, std::abs(pa(i) - pb(i)));
-    diff[k] = global_max(d) / tz.p0;
+    diff[k] = max_pressure_difference(a, b) / tz.p0;
   }
   if (test::world()->getRank() == 0)
     std::printf("[ orders ] max |p_solid_first - p_fluid_first| / p0: %.3e (dt), %.3e (dt/2)\n",

@@ -160,7 +160,7 @@ class PressureProjection {
     {
       auto cv = c.getLocalViewHost(Tpetra::Access::OverwriteAll);
       for (std::size_t i = 0; i < n; ++i)
-        cv(i, 0) = roles_[i] == PressureRole::Free ? 0.0 : target(i) - p.p(i);  // 0: isolated
+        cv(i, 0) = roles_[i] == PressureRole::Free ? 0.0 : target(i) - p.p(i);
     }
     full_->apply(c, ac);
     {
