@@ -19,7 +19,7 @@ log() { printf '[mupm setup] %s\n' "$*" >&2; }
 
 TRILINOS_VERSION=13.2.0
 PACKAGES=(cmake make g++ pkg-config libopenmpi-dev openmpi-bin libhdf5-openmpi-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libblas-dev liblapack-dev libsuitesparse-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libblas-dev liblapack-dev
   python3 python3-matplotlib python3-h5py python3-numpy clang-format)
 
 # ---------------------------------------------------------------- packages

@@ -45,10 +45,7 @@ LinearSolve::LinearSolve(const LinearSolveSettings& settings)
   // makes small and the test then needlessly strict).
   params->set("Implicit Residual Scaling", std::string("Norm of RHS"));
   params->set("Explicit Residual Scaling", std::string("Norm of RHS"));
-  Belos::SolverFactory<double, MV, OP> factory;
-  impl_->solver = factory.create("GMRES", params);
   impl_->params = params;
-  impl_->problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>());
 }
 
 LinearSolve::~LinearSolve() = default;
@@ -56,6 +53,11 @@ LinearSolve::~LinearSolve() = default;
 void LinearSolve::set_matrix(const Teuchos::RCP<const CrsMatrix>& a) {
   ScopedRegion region("mupm::LinearSolve::setup");
   impl_->a = a;
+  // A new problem and solver for every matrix: Belos keeps vectors of the last problem's map,
+  // and a matrix may come with another map (the fracture network grows).
+  Belos::SolverFactory<double, MV, OP> factory;
+  impl_->solver = factory.create("GMRES", impl_->params);
+  impl_->problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>());
   impl_->problem->setOperator(a);
   impl_->prec = Teuchos::null;
   if (set_.preconditioner != "None") {

@@ -35,13 +35,26 @@
 // p_f* = p_f - M_f (c - c_ref) at the opening it is at (kernels header), and its stable-step
 // estimate includes it (solvers/solid_solver.hpp); hence a_min also bounds the time step.
 //
-// The network is small (the fracture points of a 2D body lie on lines, of a 3D body on
-// surfaces): every rank gathers it whole (its points' positions, apertures, normals, bulk
-// state and neighbour ids), assembles the same symmetric, diagonally dominant system in
-// global-id order and solves it directly (sparse Cholesky,
-// include/mupm/solvers/sparse_cholesky.hpp), serially. Every rank gets the same bits whatever the
-// number of ranks or threads, and the ghosts get their p_f without an exchange. A singular system
-// stops the run (CollectiveError), never a silent garbage p_f.
+// The solve is distributed as the points are: each rank assembles the rows of its own fracture
+// points as a Tpetra CrsMatrix over the network's map (the owned fracture points' global ids),
+// its neighbours' data reaching it with the ghosts (two refreshes: on the network, held, p_f^n;
+// then conductance and start value), and Belos' GMRES with Ifpack2's ILU(0) solves for the
+// increment over p_f^n (include/mupm/solvers/linear_solve.hpp); no rank holds more of the
+// network than its own points and their ghosts. The system (free rows; held points' increments
+// are zero and their values move to the right-hand side) is symmetric with negative
+// off-diagonals and a positive diagonal that dominates strictly (storage and exchange): an
+// M-matrix, whose ILU(0) exists. The tolerance is 1e-14 of ||D x|| (D the diagonal, x the
+// solution): the scale of A x's own round-off (eps |A| |x| <= 2 eps |D x|), so the residual is
+// held to a hundred times round-off however stiff the conductances make the system (a scale of
+// ||b|| could not be reached: an open crack's condition number kappa reaches 1e8, and the
+// forward error of any double solve is kappa eps). It takes few iterations: along a crack the
+// network is nearly one-dimensional, where ILU is close to exact; the
+// subdomains of the ranks cost a few iterations more. Results therefore agree across rank and
+// thread counts to the solve's tolerance (not bit for bit; the reductions' order and the
+// subdomains differ) and restart bit for bit on the same ranks and threads. Water stays
+// conserved to round-off whatever the tolerance: the contents are updated with the flows
+// actually used, pair by pair antisymmetric. A singular system or a solve that does not
+// converge stops the run (CollectiveError), never a silent garbage p_f.
 //
 // Water content: each fracture point's content grows by what flowed in over the step,
 //   dt (sum_j Lambda_ij (p_j - p_i) + Q_i) + X_i,
@@ -83,8 +96,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -96,20 +109,29 @@
 #include "mupm/kernels/fracture.hpp"
 #include "mupm/kernels/fracture_flow.hpp"
 #include "mupm/mesh/discretization.hpp"
+#include "mupm/solvers/linear_solve.hpp"
 #include "mupm/solvers/module.hpp"
-#include "mupm/solvers/sparse_cholesky.hpp"
 
 namespace mupm {
 
 template <int Dim>
 class FractureFlow {
   static_assert(Kokkos::SpaceAccessibility<HostSpace, MemSpace>::accessible,
-                "the network is packed on the host");
+                "the network is assembled on the host");
 
  public:
+  // The network's solve (header): ILU(0)-preconditioned GMRES to 1e-14 of ||D x||.
+  static LinearSolveSettings solve_settings() {
+    LinearSolveSettings s;
+    s.preconditioner = "ILU";
+    s.fill_level = 0;
+    s.tolerance = 1e-14;
+    return s;
+  }
+
   FractureFlow(Discretization<Dim>& disc, const FluidParams& fluid, const FractureParams& prm,
                const std::vector<BoundaryCondition>& bcs, MPI_Comm comm)
-      : disc_(disc), fluid_(fluid), prm_(prm), comm_(comm) {
+      : disc_(disc), fluid_(fluid), prm_(prm), comm_(comm), solver_(solve_settings()) {
     for (const auto& bc : bcs)
       if (bc.kind == BoundaryCondition::FracturePressure ||
           bc.kind == BoundaryCondition::FractureSource) {
@@ -121,6 +143,9 @@ class FractureFlow {
                                  "(GridSpec::mirrored_layers)");
       }
     inflow_.assign(bcs_.size(), 0.0);
+    const std::size_t n = disc.points.size();
+    shared_ = Vectors("mupm::fracture_network", n, 3);
+    coupled_ = Vectors("mupm::fracture_conductance", n, 2);
   }
 
   // Names of the conditions, with the water [kg] that entered through each so far.
@@ -128,8 +153,8 @@ class FractureFlow {
   std::vector<double>& inflows() { return inflow_; }
   const std::vector<double>& inflows() const { return inflow_; }
   long long network_size() const { return last_size_; }
-  // Non-zeros of the last factorization's L (its fill), for the benchmarks.
-  double last_factor_nnz() const { return last_factor_nnz_; }
+  // GMRES iterations of the last solve (0 without a network), for the benchmarks.
+  int last_iterations() const { return last_iterations_; }
 
   // The crack water's energy terms since t = 0 [J] (header), the same on every rank.
   struct Energy {
@@ -157,10 +182,12 @@ class FractureFlow {
   // [1/s] the bulk loses, written for every owned point (0 off the network).
   void step(double t, double dt, const Scalars& phat, const Scalars& C, const Scalars& sink) {
     ScopedRegion region("mupm::FractureFlow::step");
-    gather(phat, C);
-    const int n = int(gid_.size());
-    last_size_ = n;
     Kokkos::deep_copy(sink, 0.0);
+    collect(phat, C);
+    long long n = (long long)net_.size();
+    MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    last_size_ = n;
+    last_iterations_ = 0;
     if (n == 0) {
       // No fracture point anywhere (yet): a Fracture Source has nowhere to put its water.
       for (const auto& bc : bcs_)
@@ -169,111 +196,64 @@ class FractureFlow {
       return;
     }
     assemble(t, dt);
-    solve();
+    solve(dt);
     scatter(dt, sink);
   }
 
  private:
-  // Per gathered point: the doubles of a record (gather()), in this order.
-  enum Slot { kGid, kVol, kOpen, kOpenRef, kPhat, kC, kG, kBulkFixed, kPold, kRegions, kNnb, kX };
-  // then x[Dim], n[Dim], and the global ids of the point's mirrors (Discretization::mirror's
-  // Dim + 1 columns; -1 for none, or without mirrored layers)
-  static constexpr int kMirror = kX + 2 * Dim;
-  static constexpr int kFresh = kMirror + Dim + 1;  // 1: joins the network now
-  static constexpr int kRecord = kFresh + 1;
+  // An owned network point: its local id and its state at the step's start.
+  struct Node {
+    LocalId i;
+    double open, open_ref, phat, C, G, pold;
+    bool bulk_fixed, fresh;
+    double nrm[Dim];
+  };
   static constexpr double kConductanceCap = 1e8;  // assemble()
 
-  void gather(const Scalars& phat, const Scalars& C) {
+  // The owned network points, whether each point is held, and what its neighbours need: on the
+  // network, the held condition (-1: none), p_f^n (p_w for a point that joins now).
+  void collect(const Scalars& phat, const Scalars& C) {
     auto& p = disc_.points;
     const auto& b = disc_.bonds;
-    const double dx = disc_.grid.dx;
-    const double g0 = 2.0 * fluid_.mobility / (dx * dx);  // G / k_r (eq 19, kernels header)
-    std::vector<double> rec;
-    std::vector<long long> nb;
+    const double g0 = 2.0 * fluid_.mobility / (disc_.grid.dx * disc_.grid.dx);  // G / k_r (eq 19)
+    net_.clear();
+    Kokkos::deep_copy(shared_, 0.0);
     for (std::size_t i = 0; i < p.n_owned; ++i) {
       if (!p.fracture(i))
         continue;
-      double nrm[Dim];
-      if (!crack_normal<Dim>(b.offsets, b.neighbor, b.intact, p.x, i, nrm))
+      Node nd;
+      nd.i = LocalId(i);
+      if (!crack_normal<Dim>(b.offsets, b.neighbor, b.intact, p.x, i, nd.nrm))
         for (int d = 0; d < Dim; ++d)
-          nrm[d] = 0;
-      const bool fresh = !(p.pf_saturation(i) > 0);
-      const double open = mean_opening<Dim>(b.offsets, b.neighbor, b.intact, p.x, p.u, p.volume, i);
-      const BondIndex e0 = b.offsets(i), e1 = b.offsets(i + 1);
-      const double r[kX] = {double(p.gid(i)),
-                            p.volume(i),
-                            open,
-                            fresh ? open : p.pf_aperture(i),
-                            phat(i),
-                            C(i),
-                            g0 * p.rel_perm(i),
-                            (p.fixed(i) & kFixedPressure) ? 1.0 : 0.0,
-                            fresh ? p.p(i) : p.pf(i),
-                            double(p.regions(i)),
-                            double(e1 - e0)};
-      rec.insert(rec.end(), r, r + kX);
-      for (int d = 0; d < Dim; ++d)
-        rec.push_back(p.x(i, d));
-      for (int d = 0; d < Dim; ++d)
-        rec.push_back(nrm[d]);
-      const bool mirrors = disc_.mirror.extent(0) > 0;
-      for (int c = 0; c <= Dim; ++c) {
-        const LocalId m = mirrors ? disc_.mirror(i, c) : LocalId(-1);
-        rec.push_back(m >= 0 ? double(p.gid(m)) : -1.0);
-      }
-      rec.push_back(fresh ? 1.0 : 0.0);
-      for (BondIndex e = e0; e < e1; ++e)
-        nb.push_back(p.gid(b.neighbor(e)));
+          nd.nrm[d] = 0;
+      nd.fresh = !(p.pf_saturation(i) > 0);
+      nd.open = mean_opening<Dim>(b.offsets, b.neighbor, b.intact, p.x, p.u, p.volume, i);
+      nd.open_ref = nd.fresh ? nd.open : p.pf_aperture(i);
+      nd.phat = phat(i);
+      nd.C = C(i);
+      nd.G = g0 * p.rel_perm(i);
+      nd.bulk_fixed = (p.fixed(i) & kFixedPressure) != 0;
+      nd.pold = nd.fresh ? p.p(i) : p.pf(i);
+      int held = -1;  // later conditions win
+      for (std::size_t k = 0; k < bcs_.size(); ++k)
+        if (bcs_[k].kind == BoundaryCondition::FracturePressure && in(bcs_[k], i))
+          held = int(k);
+      shared_(i, 0) = 1;
+      shared_(i, 1) = held;
+      shared_(i, 2) = nd.pold;
+      net_.push_back(nd);
     }
-    std::vector<double> all_rec = allgather(rec, MPI_DOUBLE);
-    std::vector<long long> all_nb = allgather(nb, MPI_LONG_LONG);
-    const int n = int(all_rec.size() / kRecord);
-    // Global-id order, whatever the ranks.
-    std::vector<long long> first(n + 1, 0);
-    for (int k = 0; k < n; ++k)
-      first[k + 1] = first[k] + (long long)all_rec[std::size_t(k) * kRecord + kNnb];
-    std::vector<int> order(n);
-    std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(), [&](int a, int c) {
-      return all_rec[std::size_t(a) * kRecord] < all_rec[std::size_t(c) * kRecord];
-    });
-    rec_.resize(std::size_t(n) * kRecord);
-    gid_.resize(n);
-    nb_.clear();
-    nb_first_.assign(1, 0);
-    for (int k = 0; k < n; ++k) {
-      const int s = order[k];
-      std::copy(all_rec.begin() + std::size_t(s) * kRecord,
-                all_rec.begin() + std::size_t(s + 1) * kRecord,
-                rec_.begin() + std::size_t(k) * kRecord);
-      gid_[k] = (long long)rec_[std::size_t(k) * kRecord];
-      nb_.insert(nb_.end(), all_nb.begin() + first[s], all_nb.begin() + first[s + 1]);
-      nb_first_.push_back((long long)nb_.size());
-    }
+    disc_.dist.refresh({shared_});
   }
 
-  template <class T>
-  std::vector<T> allgather(const std::vector<T>& mine, MPI_Datatype type) const {
-    int size = 0;
-    MPI_Comm_size(comm_, &size);
-    int count = int(mine.size());
-    std::vector<int> counts(size), displs(size, 0);
-    MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-    for (int r = 1; r < size; ++r)
-      displs[r] = displs[r - 1] + counts[r - 1];
-    std::vector<T> out(std::size_t(displs[size - 1] + counts[size - 1]));
-    MPI_Allgatherv(mine.data(), count, type, out.data(), counts.data(), displs.data(), type, comm_);
-    return out;
+  bool in(const BoundaryCondition& bc, std::size_t i) const {
+    return bc.region_mask == 0 || (disc_.points.regions(i) & bc.region_mask);
   }
-
-  int index_of(long long gid) const {
-    auto it = std::lower_bound(gid_.begin(), gid_.end(), gid);
-    return it != gid_.end() && *it == gid ? int(it - gid_.begin()) : -1;
-  }
-  double r(int k, int slot) const { return rec_[std::size_t(k) * kRecord + slot]; }
+  bool on(LocalId j) const { return shared_(j, 0) != 0; }
+  int held(LocalId j) const { return int(shared_(j, 1)); }
 
   // A Fracture Source's rate q [m^3/s] at t; an error when it injects (q != 0) but its region
-  // holds no fracture point (volume vsum) on the gathered network, the same on every rank.
+  // holds no fracture point (volume vsum, all ranks), the same on every rank.
   double check_source(const BoundaryCondition& bc, double t, double vsum) const {
     const double h = Dim == 2 ? disc_.grid.thickness : 1.0;
     const double q = bc.value * bc.time(t) * h;
@@ -284,125 +264,120 @@ class FractureFlow {
     return q;
   }
 
-  // The system of the header, in global-id order: CSR adjacency, conductances, diagonal,
-  // right-hand side; prescribed p_f and the sources at t + dt / t.
+  // Throws on every rank the message of the lowest rank that has one.
+  void collective_throw(const std::string& mine) const {
+    int rank = 0, size = 1;
+    MPI_Comm_rank(comm_, &rank);
+    MPI_Comm_size(comm_, &size);
+    int root = mine.empty() ? size : rank;
+    MPI_Allreduce(MPI_IN_PLACE, &root, 1, MPI_INT, MPI_MIN, comm_);
+    if (root == size)
+      return;
+    std::string text = mine;
+    int len = int(text.size());
+    MPI_Bcast(&len, 1, MPI_INT, root, comm_);
+    text.resize(std::size_t(len));
+    MPI_Bcast(&text[0], len, MPI_CHAR, root, comm_);
+    throw CollectiveError(text);
+  }
+
+  // The rows of the owned network points (header): adjacency, conductances, diagonal,
+  // right-hand side; the sources at t, the prescribed p_f at t + dt.
   void assemble(double t, double dt) {
-    const int n = int(gid_.size());
+    auto& p = disc_.points;
+    const auto& b = disc_.bonds;
+    const std::size_t n = net_.size();
     const double dx = disc_.grid.dx;
     const double mu = prm_.viscosity, amin = prm_.min_aperture;
     const double inv_kw = 1.0 / fluid_.bulk_modulus;
     const VanGenuchten vg = fluid_.retention;
     adj_first_.assign(1, 0);
     adj_.clear();
-    std::vector<double> kappa(n, 0.0);
+    kappa_.assign(n, 0.0);
     storage_.assign(n, 0.0);
     phi_f_.assign(n, 0.0);
     opening_.assign(n, 0.0);
     rows_.assign(n, 1);
     gexch_.assign(n, 0.0);
-    for (int i = 0; i < n; ++i) {
-      std::vector<int> js;
-      for (long long e = nb_first_[i]; e < nb_first_[i + 1]; ++e) {
-        const int j = index_of(nb_[e]);
-        if (j >= 0 && j != i)
+    double floor = std::numeric_limits<double>::infinity();
+    std::vector<LocalId> js;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Node& nd = net_[k];
+      const LocalId i = nd.i;
+      js.clear();
+      for (BondIndex e = b.offsets(i); e < b.offsets(i + 1); ++e) {
+        const LocalId j = b.neighbor(e);
+        if (j != i && on(j))
           js.push_back(j);
       }
       std::sort(js.begin(), js.end());
       js.erase(std::unique(js.begin(), js.end()), js.end());
       double m = 0;
       int rows = 1;
-      for (int j : js) {
+      for (const LocalId j : js) {
         double xi[Dim], xn = 0, par2 = 0;
         for (int d = 0; d < Dim; ++d) {
-          xi[d] = r(j, kX + d) - r(i, kX + d);
-          xn += xi[d] * r(i, kX + Dim + d);
+          xi[d] = p.x(j, d) - p.x(i, d);
+          xn += xi[d] * nd.nrm[d];
         }
         for (int d = 0; d < Dim; ++d) {
-          const double q = xi[d] - xn * r(i, kX + Dim + d);
+          const double q = xi[d] - xn * nd.nrm[d];
           par2 += q * q;
         }
         m += par2 / (Dim - 1);
         rows += par2 < 0.25 * dx * dx ? 1 : 0;
         adj_.push_back(j);
       }
-      adj_first_.push_back((long long)adj_.size());
-      const double a = std::max(r(i, kOpen), amin);  // the aperture max(c, 0), at least a_min
-      const double area = r(i, kVol) / (rows * dx);  // A_i
-      kappa[i] = m > 0 ? a * a * a * area / (6.0 * mu * m) : 0.0;     // kernels header
-      const double film = std::max(amin + r(i, kOpen), 0.01 * amin);  // header
-      const double phi_f = film / (rows * dx);
-      phi_f_[i] = phi_f;
-      const double pold = r(i, kPold), sat = vg.saturation(pold);
-      storage_[i] = phi_f * (vg.dsaturation_dp(pold) + sat * inv_kw);
-      opening_[i] = sat * (r(i, kOpen) - r(i, kOpenRef)) / (rows * dx);  // S_rf d(phi_f)
-      rows_[i] = rows;
-      const double G = r(i, kG), Cb = r(i, kC);
-      gexch_[i] = r(i, kBulkFixed) != 0 ? G : (Cb > 0 ? G * Cb / (Cb + dt * G) : 0.0);
+      adj_first_.push_back(adj_.size());
+      const double v = p.volume(i);
+      const double a = std::max(nd.open, amin);  // the aperture max(c, 0), at least a_min
+      const double area = v / (rows * dx);       // A_i
+      kappa_[k] = m > 0 ? a * a * a * area / (6.0 * mu * m) : 0.0;  // kernels header
+      const double film = std::max(amin + nd.open, 0.01 * amin);    // header
+      phi_f_[k] = film / (rows * dx);
+      const double sat = vg.saturation(nd.pold);
+      storage_[k] = phi_f_[k] * (vg.dsaturation_dp(nd.pold) + sat * inv_kw);
+      opening_[k] = sat * (nd.open - nd.open_ref) / (rows * dx);  // S_rf d(phi_f)
+      rows_[k] = rows;
+      gexch_[k] = nd.bulk_fixed ? nd.G : (nd.C > 0 ? nd.G * nd.C / (nd.C + dt * nd.G) : 0.0);
+      floor = std::min(floor, v * (storage_[k] / dt + gexch_[k]));
     }
-    lambda_.resize(adj_.size());
-    diag_.assign(n, 0.0);
-    rhs_.assign(n, 0.0);
-    source_.assign(n, 0.0);
     // Conditioning: a wide-open crack's conductances exceed V C_f / dt by more than the 16
     // digits of a double, and the pressure level of a network component (set by its storage)
-    // would be lost in round-off (an exactly singular LU). Conductances are capped at
-    // kConductanceCap times the smallest storage-plus-exchange term of the network: at the
-    // cap the pressure evens out over 1e4 points along the crack within one step, so the cap
-    // changes what the crack does by less than the step's own error. Water is conserved
-    // whatever the cap (contents come from the flows actually used).
-    double floor = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < n; ++i)
-      floor = std::min(floor, r(i, kVol) * (storage_[i] / dt + gexch_[i]));
+    // would be lost in round-off. Conductances are capped at kConductanceCap times the
+    // smallest storage-plus-exchange term of the network: at the cap the pressure evens out
+    // over 1e4 points along the crack within one step, so the cap changes what the crack does
+    // by less than the step's own error. Water is conserved whatever the cap (contents come
+    // from the flows actually used).
+    MPI_Allreduce(MPI_IN_PLACE, &floor, 1, MPI_DOUBLE, MPI_MIN, comm_);
     const double cap = kConductanceCap * floor;
-    for (int i = 0; i < n; ++i) {
-      double s = 0;
-      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e) {
-        lambda_[e] = std::min(0.5 * (kappa[i] + kappa[adj_[e]]), cap);
-        s += lambda_[e];
-      }
-      const double v = r(i, kVol);
-      diag_[i] = v * storage_[i] / dt + v * gexch_[i] + s;
-      if (!std::isfinite(diag_[i]) || !std::isfinite(r(i, kPold)) || !std::isfinite(r(i, kPhat)))
-        throw CollectiveError("Error, fracture point " + std::to_string(gid_[i]) + " at (" +
-                              std::to_string(r(i, kX)) + ", " + std::to_string(r(i, kX + 1)) +
-                              ") has a non-finite aperture or pressure (aperture " +
-                              std::to_string(std::max(r(i, kOpen), 0.0)) + " m, p_f " +
-                              std::to_string(r(i, kPold)) + " Pa): the run has become unstable.");
-      rhs_[i] =
-          v * storage_[i] / dt * r(i, kPold) + v * gexch_[i] * r(i, kPhat) - v * opening_[i] / dt;
-    }
-    // Conditions: sources [m^3/s] spread by volume over their network points at t; prescribed
-    // p_f at t + dt (later conditions win).
-    held_.assign(n, -1);
+    // Sources [m^3/s] spread by volume over their network points at t (region volumes summed
+    // over the ranks); prescribed p_f at t + dt (later conditions win).
+    std::vector<double> vsum(bcs_.size(), 0.0);
+    for (std::size_t c = 0; c < bcs_.size(); ++c)
+      if (bcs_[c].kind == BoundaryCondition::FractureSource)
+        for (const Node& nd : net_)
+          if (in(bcs_[c], nd.i))
+            vsum[c] += p.volume(nd.i);
+    if (!vsum.empty())
+      MPI_Allreduce(MPI_IN_PLACE, vsum.data(), int(vsum.size()), MPI_DOUBLE, MPI_SUM, comm_);
+    source_.assign(n, 0.0);
     held_value_.assign(n, 0.0);
-    for (std::size_t k = 0; k < bcs_.size(); ++k) {
-      const auto& bc = bcs_[k];
-      const std::uint32_t mask = bc.region_mask;
-      auto in = [&](int i) { return mask == 0 || (std::uint32_t(r(i, kRegions)) & mask); };
+    for (std::size_t c = 0; c < bcs_.size(); ++c) {
+      const auto& bc = bcs_[c];
       if (bc.kind == BoundaryCondition::FractureSource) {
-        double vsum = 0;
-        for (int i = 0; i < n; ++i)
-          if (in(i))
-            vsum += r(i, kVol);
-        const double q = check_source(bc, t, vsum);
-        for (int i = 0; i < n; ++i)
-          if (in(i))
-            source_[i] += q * r(i, kVol) / vsum;
-        inflow_[k] += fluid_.water_density * q * dt;
-      } else {
-        const double value = bc.value * bc.time(t + dt);
-        for (int i = 0; i < n; ++i)
-          if (in(i)) {
-            held_[i] = int(k);
-            held_value_[i] = value;
-          }
+        const double q = check_source(bc, t, vsum[c]);
+        for (std::size_t k = 0; k < n; ++k)
+          if (in(bc, net_[k].i))
+            source_[k] += q * p.volume(net_[k].i) / vsum[c];
+        inflow_[c] += fluid_.water_density * q * dt;
       }
     }
-    // Mirrored Fracture Pressure (Boundary Layer Values = Mirrored; the boundary-layer issue):
-    // a held point L outside the condition's face whose mirror m is a network point that no
-    // condition holds takes 2 g - q, q the mirror's pressure, so that p_f passes through g at
-    // the face. Implicit in m it would couple m to L's neighbours unsymmetrically (no Cholesky),
-    // so q comes from the step's start, relaxed by a half:
+    // Mirrored Fracture Pressure (Boundary Layer Values = Mirrored): a held point L outside
+    // the condition's face whose mirror m is a network point that no condition holds takes
+    // 2 g - q, q the mirror's pressure, so that p_f passes through g at the face. Implicit in m
+    // it would couple m to L's neighbours unsymmetrically, so q comes from the step's start,
+    // relaxed by a half:
     //   q = (q^n + p_f^n(m)) / 2,   q^n = 2 g(t) - p_f^n(L) (what L held; p_f^n(m) if L joins now).
     // Unrelaxed (q = p_f^n(m)) the crack's pressure oscillated without decay when its storage is
     // small against its conductances (the interior then follows the held values almost
@@ -411,163 +386,214 @@ class FractureFlow {
     // step, and a steady state is the reflection's exactly. q^n is rebuilt from the
     // checkpointed p_f, so a restart continues bit for bit. A held point whose mirror is not on
     // the network, or is held, keeps g.
-    std::vector<double> reflected(n, 0.0);
-    for (int i = 0; i < n; ++i) {
-      if (held_[i] < 0 || !bcs_[std::size_t(held_[i])].mirrored)
+    for (std::size_t k = 0; k < n; ++k) {
+      const Node& nd = net_[k];
+      const int h = held(nd.i);
+      if (h < 0)
         continue;
-      const auto& bc = bcs_[std::size_t(held_[i])];
-      const auto mg = (long long)r(i, kMirror + bc.mirror_column);
-      const int j = mg >= 0 ? index_of(mg) : -1;
-      if (j < 0 || held_[j] >= 0) {
-        reflected[i] = held_value_[i];
+      const auto& bc = bcs_[std::size_t(h)];
+      const double g = bc.value * bc.time(t + dt);
+      held_value_[k] = g;
+      const LocalId m = bc.mirrored ? disc_.mirror(nd.i, bc.mirror_column) : LocalId(-1);
+      if (m < 0 || !on(m) || held(m) >= 0)
         continue;
-      }
-      const double pm = r(j, kPold);
-      const double q =
-          r(i, kFresh) != 0 ? pm : 0.5 * ((2 * bc.value * bc.time(t) - r(i, kPold)) + pm);
-      reflected[i] = 2 * held_value_[i] - q;
+      const double pm = shared_(m, 2);
+      const double q = nd.fresh ? pm : 0.5 * ((2 * bc.value * bc.time(t) - nd.pold) + pm);
+      held_value_[k] = 2 * g - q;
     }
-    for (int i = 0; i < n; ++i)
-      if (held_[i] >= 0 && bcs_[std::size_t(held_[i])].mirrored)
-        held_value_[i] = reflected[i];
-    for (int i = 0; i < n; ++i)
-      rhs_[i] += source_[i];
+    // The start value x0 (held value or p_f^n) and the conductance reach the neighbours.
+    for (std::size_t k = 0; k < n; ++k) {
+      coupled_(net_[k].i, 0) = kappa_[k];
+      coupled_(net_[k].i, 1) = held(net_[k].i) >= 0 ? held_value_[k] : net_[k].pold;
+    }
+    disc_.dist.refresh({coupled_});
+    lambda_.resize(adj_.size());
+    diag_.assign(n, 0.0);
+    rhs_.assign(n, 0.0);
+    std::string bad;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Node& nd = net_[k];
+      double s = 0;
+      for (std::size_t e = adj_first_[k]; e < adj_first_[k + 1]; ++e) {
+        lambda_[e] = std::min(0.5 * (kappa_[k] + coupled_(adj_[e], 0)), cap);
+        s += lambda_[e];
+      }
+      const double v = p.volume(nd.i);
+      diag_[k] = v * storage_[k] / dt + v * gexch_[k] + s;
+      if (bad.empty() &&
+          (!std::isfinite(diag_[k]) || !std::isfinite(nd.pold) || !std::isfinite(nd.phat)))
+        bad = "Error, fracture point " + std::to_string(p.gid(nd.i)) + " at (" +
+              std::to_string(p.x(nd.i, 0)) + ", " + std::to_string(p.x(nd.i, 1)) +
+              ") has a non-finite aperture or pressure (aperture " +
+              std::to_string(std::max(nd.open, 0.0)) + " m, p_f " + std::to_string(nd.pold) +
+              " Pa): the run has become unstable.";
+      rhs_[k] = v * storage_[k] / dt * nd.pold + v * gexch_[k] * nd.phat - v * opening_[k] / dt +
+                source_[k];
+    }
+    collective_throw(bad);
   }
 
-  // The free rows' system, the held values moved to the right-hand side, solved directly by a
-  // sparse Cholesky factorization (include/mupm/solvers/sparse_cholesky.hpp): the system is
-  // symmetric (lambda_ij = lambda_ji) and strictly diagonally dominant with a positive diagonal,
-  // hence positive definite. Direct, as the conductances along an open crack exceed the storage
-  // by many orders (an iterative solver would need a condition-number-dependent number of
-  // iterations). Free rows keep the global-id order, so every rank factors the same matrix.
-  void solve() {
-    const int n = int(gid_.size());
+  // The increment y = p_f - x0 of the free rows (header): A y = rhs - A_full x0, held rows
+  // y = 0 (a diagonal row: held neighbours leave the matrix, keeping it symmetric).
+  void solve(double dt) {
+    auto& p = disc_.points;
+    const std::size_t n = net_.size();
+    std::vector<GlobalId> ids(n);
+    for (std::size_t k = 0; k < n; ++k)
+      ids[k] = p.gid(net_[k].i);
+    const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+    auto map = Teuchos::rcp(
+        new Map(invalid, Teuchos::ArrayView<const GlobalId>(ids), 0, disc_.dist.comm()));
+    std::size_t longest = 1;
+    for (std::size_t k = 0; k < n; ++k)
+      longest = std::max(longest, adj_first_[k + 1] - adj_first_[k] + 1);
+    auto a = Teuchos::rcp(new CrsMatrix(map, longest));
+    TpetraVector rhs(map), y(map);
+    double norm = 0;  // ||D x0||: the round-off scale of A x (header)
+    {
+      auto bv = rhs.getLocalViewHost(Tpetra::Access::OverwriteAll);
+      auto yv = y.getLocalViewHost(Tpetra::Access::OverwriteAll);
+      std::vector<GlobalId> cols;
+      std::vector<double> vals;
+      for (std::size_t k = 0; k < n; ++k) {
+        const LocalId i = net_[k].i;
+        cols.assign(1, ids[k]);
+        vals.assign(1, diag_[k]);
+        const bool free = held(i) < 0;
+        const double x0 = coupled_(i, 1);
+        double r = rhs_[k] - diag_[k] * x0;
+        for (std::size_t e = adj_first_[k]; free && e < adj_first_[k + 1]; ++e) {
+          const LocalId j = adj_[e];
+          r += lambda_[e] * coupled_(j, 1);
+          if (held(j) < 0) {
+            cols.push_back(p.gid(j));
+            vals.push_back(-lambda_[e]);
+          }
+        }
+        a->insertGlobalValues(ids[k], Teuchos::ArrayView<const GlobalId>(cols),
+                              Teuchos::ArrayView<const double>(vals));
+        bv(k, 0) = free ? r : 0.0;
+        yv(k, 0) = free && !net_[k].fresh ? p.pf_rate(i) * dt : 0.0;
+        norm += free ? diag_[k] * x0 * diag_[k] * x0 : 0.0;
+      }
+    }
+    a->fillComplete(map, map);
+    solver_.set_matrix(a);
+    // The tolerance is relative to ||D x|| at the solution; that of the start value is tried
+    // first, and when the solution is larger (water let into a network at rest), the solve
+    // goes on from where it stopped with the solution's.
+    auto scaled = [&](const TpetraVector& v) {
+      auto vv = v.getLocalViewHost(Tpetra::Access::ReadOnly);
+      double s = 0;
+      for (std::size_t k = 0; k < n; ++k)
+        if (held(net_[k].i) < 0)
+          s += std::pow(diag_[k] * (coupled_(net_[k].i, 1) + vv(k, 0)), 2);
+      MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
+      return std::sqrt(s);
+    };
+    MPI_Allreduce(MPI_IN_PLACE, &norm, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    double scale = std::sqrt(norm);
+    LinearSolveResult res = solver_.solve(rhs, y, scale);
+    last_iterations_ = res.iterations;
+    if (!res.converged) {
+      double again = scaled(y);
+      if (again > scale) {
+        res = solver_.solve(rhs, y, again);
+        last_iterations_ += res.iterations;
+      }
+    }
+    if (!res.converged) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "(relative residual %.3g after %d GMRES iterations, tolerance %.3g).",
+                    res.residual, last_iterations_, solver_.settings().tolerance);
+      throw CollectiveError("Error, the fracture-pressure system of " + std::to_string(last_size_) +
+                            " fracture points did not converge " + text);
+    }
     x_.assign(n, 0.0);
-    std::vector<int> pos(n, -1);  // column of a free row
-    int m = 0;
-    for (int i = 0; i < n; ++i) {
-      if (held_[i] >= 0)
-        x_[i] = held_value_[i];
-      else
-        pos[i] = m++;
-    }
-    if (m == 0)
-      return;
-    LowerCsc a;
-    a.n = m;
-    a.first.assign(1, 0);
-    std::vector<double> b(m);
-    std::vector<std::pair<int, double>> col;
-    for (int i = 0; i < n; ++i) {
-      if (pos[i] < 0)
-        continue;
-      double rhs = rhs_[i];
-      col.assign(1, {pos[i], diag_[i]});
-      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e) {
-        const int j = adj_[e];
-        if (pos[j] < 0)
-          rhs += lambda_[e] * x_[j];  // a held neighbour
-        else if (pos[j] > pos[i])
-          col.push_back({pos[j], -lambda_[e]});
-      }
-      std::sort(col.begin() + 1, col.end());
-      for (const auto& [row, v] : col) {
-        a.row.push_back(row);
-        a.value.push_back(v);
-      }
-      a.first.push_back(int(a.row.size()));
-      b[pos[i]] = rhs;
-    }
-    const CholeskyResult res = solve_spd(a, b);
-    bool finite = res.ok;
-    for (int k = 0; finite && k < m; ++k)
-      finite = std::isfinite(b[k]);
-    if (!finite)
-      throw CollectiveError(
-          "Error, the fracture-pressure system of " + std::to_string(m) +
-          " fracture points could not be solved (" +
-          (res.ok ? std::string("non-finite solution")
-                  : "factorization stopped at column " + std::to_string(res.failed_column)) +
-          ").");
-    for (int i = 0; i < n; ++i)
-      if (pos[i] >= 0)
-        x_[i] = b[pos[i]];
-    last_factor_nnz_ = res.factor_nnz;
+    auto yv = y.getLocalViewHost(Tpetra::Access::ReadOnly);
+    for (std::size_t k = 0; k < n; ++k)
+      x_[k] = coupled_(net_[k].i, 1) + (held(net_[k].i) < 0 ? yv(k, 0) : 0.0);
   }
 
-  // The new p_f, S_rf, rates and contents onto the local points, the exchange into `sink`,
+  // The new p_f and S_rf (onto the ghosts too), rates and contents, the exchange into `sink`,
   // the reservoirs' supply into the conditions' inflows.
   void scatter(double dt, const Scalars& sink) {
     auto& p = disc_.points;
-    const int n = int(gid_.size());
+    const std::size_t n = net_.size();
     const VanGenuchten vg = fluid_.retention;
-    std::vector<double> supplied(bcs_.size(), 0.0);
-    std::vector<double> gain(n), exch(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      p.pf(net_[k].i) = x_[k];
+      p.pf_saturation(net_[k].i) = vg.saturation(x_[k]);
+    }
+    disc_.dist.refresh({as_vectors(p.pf), as_vectors(p.pf_saturation)});
     const double inv_kw = 1.0 / fluid_.bulk_modulus;
-    Energy de;  // this step's terms (header), summed in global-id order on every rank
-    for (int i = 0; i < n; ++i) {
+    // This step's energy terms (header), then the reservoirs' supply per condition.
+    std::vector<double> sums(5 + bcs_.size(), 0.0);
+    double* de = sums.data();
+    double* supplied = sums.data() + 5;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Node& nd = net_[k];
+      const LocalId i = nd.i;
       double flow = 0;
-      for (long long e = adj_first_[i]; e < adj_first_[i + 1]; ++e)
-        flow += lambda_[e] * (x_[adj_[e]] - x_[i]);
-      const double v = r(i, kVol), pold = r(i, kPold);
-      const double pm = 0.5 * (pold + x_[i]);
-      exch[i] = dt * v * gexch_[i] * (r(i, kPhat) - x_[i]);
-      gain[i] = dt * (flow + source_[i]) + exch[i];
-      de.stored += v * phi_f_[i] *
-                   (stored_energy_density(vg, 1.0, inv_kw, x_[i]) -
-                    stored_energy_density(vg, 1.0, inv_kw, pold));
-      de.skeleton_work += pm * v * opening_[i];
-      de.dissipation -= pm * dt * flow;
-      de.external_work += pm * dt * source_[i];
-      de.exchange_work += pm * exch[i];
-      if (held_[i] >= 0) {
-        const double stored = v * (storage_[i] * (x_[i] - pold) + opening_[i]);
-        supplied[held_[i]] += stored - gain[i];
-        de.external_work += pm * (stored - gain[i]);
-        gain[i] = stored;
+      for (std::size_t e = adj_first_[k]; e < adj_first_[k + 1]; ++e)
+        flow += lambda_[e] * (p.pf(adj_[e]) - x_[k]);
+      const double v = p.volume(i), pold = nd.pold;
+      const double pm = 0.5 * (pold + x_[k]);
+      const double exch = dt * v * gexch_[k] * (nd.phat - x_[k]);
+      double gain = dt * (flow + source_[k]) + exch;
+      de[0] += v * phi_f_[k] *
+               (stored_energy_density(vg, 1.0, inv_kw, x_[k]) -
+                stored_energy_density(vg, 1.0, inv_kw, pold));
+      de[1] += pm * v * opening_[k];
+      de[2] -= pm * dt * flow;
+      de[3] += pm * dt * source_[k];
+      de[4] += pm * exch;
+      const int h = held(i);
+      if (h >= 0) {
+        const double stored = v * (storage_[k] * (x_[k] - pold) + opening_[k]);
+        supplied[h] += stored - gain;
+        de[3] += pm * (stored - gain);
+        gain = stored;
       }
+      p.pf_rate(i) = (x_[k] - pold) / dt;
+      p.pf_content(i) += gain / v;
+      p.pf_aperture(i) = nd.open;
+      p.pf_area(i) = v / (rows_[k] * disc_.grid.dx);  // A_i (kernels header)
+      // The undrained modulus M_f = S_rf/(C_f n_i dx) of the solid's p_f* (kernels header):
+      // 0 on a point of prescribed p_f.
+      p.pf_modulus(i) =
+          h >= 0 ? 0.0 : vg.saturation(pold) / (storage_[k] * rows_[k] * disc_.grid.dx);
+      sink(i) = exch / (dt * v);
     }
-    energy_.stored += de.stored;
-    energy_.skeleton_work += de.skeleton_work;
-    energy_.dissipation += de.dissipation;
-    energy_.external_work += de.external_work;
-    energy_.exchange_work += de.exchange_work;
-    for (std::size_t k = 0; k < bcs_.size(); ++k)
-      inflow_[k] += fluid_.water_density * supplied[k];
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const int k = index_of(p.gid(i));
-      if (k < 0)
-        continue;
-      if (i < p.n_owned) {
-        p.pf_rate(i) = (x_[k] - r(k, kPold)) / dt;
-        p.pf_content(i) += gain[k] / r(k, kVol);
-        p.pf_aperture(i) = r(k, kOpen);
-        p.pf_area(i) = r(k, kVol) / (rows_[k] * disc_.grid.dx);  // A_i (kernels header)
-        // The undrained modulus M_f = S_rf/(C_f n_i dx) of the solid's p_f* (kernels header):
-        // 0 on a point of prescribed p_f.
-        p.pf_modulus(i) =
-            held_[k] >= 0 ? 0.0
-                          : vg.saturation(r(k, kPold)) / (storage_[k] * rows_[k] * disc_.grid.dx);
-        sink(i) = exch[k] / (dt * r(k, kVol));
-      }
-      p.pf(i) = x_[k];
-      p.pf_saturation(i) = vg.saturation(x_[k]);
-    }
+    MPI_Allreduce(MPI_IN_PLACE, sums.data(), int(sums.size()), MPI_DOUBLE, MPI_SUM, comm_);
+    energy_.stored += de[0];
+    energy_.skeleton_work += de[1];
+    energy_.dissipation += de[2];
+    energy_.external_work += de[3];
+    energy_.exchange_work += de[4];
+    for (std::size_t c = 0; c < bcs_.size(); ++c)
+      inflow_[c] += fluid_.water_density * supplied[c];
   }
 
   Discretization<Dim>& disc_;
   FluidParams fluid_;
   FractureParams prm_;
   MPI_Comm comm_;
+  LinearSolve solver_;
   std::vector<BoundaryCondition> bcs_;
   std::vector<double> inflow_;
-  // The gathered network (global-id order) and its system.
-  std::vector<long long> gid_, nb_, nb_first_, adj_first_;
-  std::vector<double> rec_, lambda_, diag_, rhs_, source_, storage_, phi_f_, opening_, gexch_, x_,
+  Vectors shared_;   // [points][3]: on the network, held condition, p_f^n (collect)
+  Vectors coupled_;  // [points][2]: conductance kappa, start value x0 (assemble)
+  // The owned network points and their rows.
+  std::vector<Node> net_;
+  std::vector<std::size_t> adj_first_;
+  std::vector<LocalId> adj_;
+  std::vector<double> kappa_, lambda_, diag_, rhs_, source_, storage_, phi_f_, opening_, gexch_, x_,
       held_value_;
-  std::vector<int> adj_, held_, rows_;
+  std::vector<int> rows_;
   long long last_size_ = 0;
-  double last_factor_nnz_ = 0;
+  int last_iterations_ = 0;
   Energy energy_;
 };
 

@@ -1,6 +1,6 @@
-// A distributed sparse linear solve on Trilinos' stack: a Tpetra CrsMatrix over the points' map,
-// Belos' GMRES and an Ifpack2
-// preconditioner (ILU(k) by default, or Jacobi), built once per matrix and reused for every
+// A distributed sparse linear solve on Trilinos' stack: a Tpetra CrsMatrix over the points' map
+// (or the fracture network's), Belos' GMRES and an Ifpack2 preconditioner (ILU(k) by default,
+// or Jacobi), built once per matrix and reused for every
 // right-hand side until the matrix changes (set_matrix). No rank ever holds more than its own
 // rows.
 //
