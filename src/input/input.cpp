@@ -489,7 +489,8 @@ RCP<ParameterList> valid_parameters() {
           "Ifpack2), "
           "distributed over the ranks like the points.");
       ps.set("Preconditioner", std::string("ILU"),
-             "Ifpack2's preconditioner: ILU (RILUK on each rank's rows), Jacobi or None.",
+             "Ifpack2's preconditioner: ILU (RILUK on each rank's rows; a breakdown, a zero "
+             "pivot, falls back to Jacobi for that matrix), Jacobi or None.",
              one_of({"ILU", "Jacobi", "None"}));
       ps.set("ILU Fill Level", 0, "Level of fill k of ILU(k).", at_least(0));
       ps.set("Tolerance", 1e-10,

@@ -4,6 +4,7 @@
 #include <BelosSolverFactory.hpp>
 #include <BelosTpetraAdapter.hpp>
 #include <Ifpack2_Factory.hpp>
+#include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_ParameterList.hpp>
 #include <algorithm>
 #include <cmath>
@@ -59,24 +60,47 @@ void LinearSolve::set_matrix(const Teuchos::RCP<const CrsMatrix>& a) {
   impl_->solver = factory.create("GMRES", impl_->params);
   impl_->problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>());
   impl_->problem->setOperator(a);
+  jacobi_ = set_.preconditioner == "Jacobi";
+  precondition();
+  ++setups_;
+}
+
+// The preconditioner of the current matrix: the settings', or Jacobi after an ILU breakdown.
+// An ILU whose factorization throws (a zero pivot caught by Ifpack2) falls back at once.
+void LinearSolve::precondition() {
   impl_->prec = Teuchos::null;
-  if (set_.preconditioner != "None") {
+  if (set_.preconditioner == "None") {
+    impl_->problem->setRightPrec(Teuchos::null);
+    return;
+  }
+  for (;;) {
     Teuchos::ParameterList p;
-    const bool ilu = set_.preconditioner == "ILU";
-    if (ilu) {
+    if (!jacobi_) {
       p.set("fact: iluk level-of-fill", set_.fill_level);
     } else {
       p.set("relaxation: type", "Jacobi");
       p.set("relaxation: sweeps", 1);
     }
-    Teuchos::RCP<const RowMatrix> rows = a;
-    impl_->prec = Ifpack2::Factory::create<RowMatrix>(ilu ? "RILUK" : "RELAXATION", rows);
-    impl_->prec->setParameters(p);
-    impl_->prec->initialize();
-    impl_->prec->compute();
-    impl_->problem->setRightPrec(impl_->prec);
+    Teuchos::RCP<const RowMatrix> rows = impl_->a;
+    int failed = 0, anywhere = 0;  // decided together: every rank then takes the same path
+    try {
+      impl_->prec = Ifpack2::Factory::create<RowMatrix>(jacobi_ ? "RELAXATION" : "RILUK", rows);
+      impl_->prec->setParameters(p);
+      impl_->prec->initialize();
+      impl_->prec->compute();
+    } catch (const std::exception&) {
+      failed = 1;
+    }
+    Teuchos::reduceAll(*impl_->a->getComm(), Teuchos::REDUCE_MAX, failed,
+                       Teuchos::outArg(anywhere));
+    if (!anywhere)
+      break;
+    if (jacobi_)
+      throw std::runtime_error("LinearSolve: the Jacobi preconditioner could not be computed");
+    jacobi_ = true;
+    ++fallbacks_;
   }
-  ++setups_;
+  impl_->problem->setRightPrec(impl_->prec);
 }
 
 LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, double& scale) {
@@ -104,20 +128,32 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
   impl_->problem->setRHS(bv);
   if (!impl_->problem->setProblem())
     throw std::logic_error("LinearSolve: Belos could not set up the problem");
-  impl_->solver->setProblem(impl_->problem);
   // Belos throws when its residual turns NaN (a singular preconditioner, a matrix gone
-  // non-finite); the same on every rank (its norms are global): a failed solve, for the caller
-  // to report.
-  try {
-    r.converged = impl_->solver->solve() == Belos::Converged;
-    r.iterations = impl_->solver->getNumIters();
-    r.residual = impl_->solver->achievedTol() * bn / scale;
-  } catch (const std::exception&) {
-    r.converged = false;
-    r.iterations = impl_->solver->getNumIters();
-    r.residual = std::numeric_limits<double>::quiet_NaN();
+  // non-finite); the same on every rank (its norms are global). An ILU(k) can meet a zero
+  // pivot on a matrix that is not an M-matrix (the projection's, measured on Example 1 case 2
+  // once the crack grew): the solve is tried again from the same initial guess with Jacobi,
+  // kept for this matrix. Otherwise a failed solve, for the caller to report.
+  TpetraVector x0(x, Teuchos::Copy);
+  for (;;) {
+    impl_->solver->setProblem(impl_->problem);
+    try {
+      r.converged = impl_->solver->solve() == Belos::Converged;
+      r.iterations = impl_->solver->getNumIters();
+      r.residual = impl_->solver->achievedTol() * bn / scale;
+    } catch (const std::exception&) {
+      r.converged = false;
+      r.iterations = impl_->solver->getNumIters();
+      r.residual = std::numeric_limits<double>::quiet_NaN();
+    }
+    if (!std::isnan(r.residual) || jacobi_ || set_.preconditioner != "ILU")
+      return r;
+    jacobi_ = true;
+    ++fallbacks_;
+    precondition();
+    x.assign(x0);
+    if (!impl_->problem->setProblem())
+      throw std::logic_error("LinearSolve: Belos could not set up the problem");
   }
-  return r;
 }
 
 }  // namespace mupm

@@ -525,7 +525,9 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
     const auto& ls = run.pressure_solve;
     out << "mupm: pore fluid, semi-implicit pressure: k/mu_w = " << f.mobility
         << " m^2/(Pa s), K_w = " << f.bulk_modulus
-        << " Pa, flow stabilization G = " << f.stabilization << "; one solve per step ("
+        << " Pa, flow stabilization G = " << f.stabilization
+        << ", pressure stabilization G_p = " << f.projection_stabilization
+        << "; one solve per step ("
         << "GMRES, " << ls.preconditioner << ", tolerance " << ls.tolerance << ")\n";
   }
   if (ph.fluid && !ph.fluid->semi_implicit()) {

@@ -294,5 +294,49 @@ TEST(PressureProjection, CheckerboardIsHeldByThePressureStabilization3D) {
   check_checkerboard<3>();
 }
 
+// An ILU(0) breakdown (include/mupm/solvers/linear_solve.hpp): blocks [[1,1,0],[1,1,1],[0,1,1]],
+// nonsingular with a unit diagonal, whose factorization without pivoting meets a zero pivot in
+// its second row (1 - 1 * 1), one block per rank on 2 ranks. The solve falls back to Jacobi and
+// reaches x = (1, 2, 3) per block, computed here; without the fallback the residual is NaN.
+TEST(LinearSolve, IluBreakdownFallsBackToJacobi) {
+  const GlobalId n = 6;
+  auto map = Teuchos::rcp(new Map(Tpetra::global_size_t(n), 0, test::world()));
+  auto a = Teuchos::rcp(new CrsMatrix(map, 3));
+  TpetraVector b(map), x(map);
+  const double block[3][3] = {{1, 1, 0}, {1, 1, 1}, {0, 1, 1}}, exact[3] = {1, 2, 3};
+  {
+    auto bv = b.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t l = 0; l < map->getNodeNumElements(); ++l) {
+      const GlobalId row = map->getGlobalElement(LocalId(l));
+      const int r = int(row % 3);
+      std::vector<GlobalId> cols;
+      std::vector<double> vals;
+      double sum = 0;
+      for (int c = 0; c < 3; ++c)
+        if (block[r][c] != 0) {
+          cols.push_back(row - r + c);
+          vals.push_back(block[r][c]);
+          sum += block[r][c] * exact[c];
+        }
+      a->insertGlobalValues(row, Teuchos::ArrayView<const GlobalId>(cols),
+                            Teuchos::ArrayView<const double>(vals));
+      bv(l, 0) = sum;
+    }
+  }
+  a->fillComplete();
+  LinearSolveSettings set;
+  set.preconditioner = "ILU";
+  set.tolerance = 1e-12;
+  LinearSolve solve(set);
+  solve.set_matrix(a);
+  double scale = 0;
+  const LinearSolveResult r = solve.solve(b, x, scale);
+  EXPECT_TRUE(r.converged);
+  EXPECT_EQ(solve.fallbacks(), 1);
+  auto xv = x.getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (std::size_t l = 0; l < map->getNodeNumElements(); ++l)
+    EXPECT_NEAR(xv(l, 0), exact[map->getGlobalElement(LocalId(l)) % 3], 1e-10);
+}
+
 }  // namespace
 }  // namespace mupm

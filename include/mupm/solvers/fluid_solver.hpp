@@ -324,11 +324,10 @@ class FluidSolver : public Module {
         << r.residual << " after " << r.iterations
         << " iterations (mupm->Solver->Pressure Solve: Tolerance, Maximum Iterations, "
            "Preconditioner)";
-      // Measured: ILU(0) broke down (a zero pivot, NaN residual) on Example 1 case 2 with
-      // incompressible water once the crack grew; Jacobi carried the run on (inputs/README.md).
+      // An ILU breakdown has been answered with Jacobi already (LinearSolve::solve).
       if (std::isnan(r.residual))
-        m << "; a NaN residual: the preconditioner broke down (ILU(k) can meet a zero pivot on "
-             "this matrix), mupm->Solver->Pressure Solve->Preconditioner = Jacobi avoids it";
+        m << "; a NaN residual, also with the Jacobi preconditioner an ILU breakdown falls back "
+             "to: the system is singular or not finite (the run has become unstable?)";
       throw CollectiveError(m.str());
     }
     skeleton.add_projection_work(r.work);

@@ -52,12 +52,16 @@ class LinearSolve {
   const LinearSolveSettings& settings() const { return set_; }
   // Preconditioner set-ups since construction (for the benchmarks).
   long long setups() const { return setups_; }
+  // ILU breakdowns since construction, each answered with Jacobi for that matrix (solve()).
+  long long fallbacks() const { return fallbacks_; }
 
  private:
+  void precondition();
   struct Impl;
   LinearSolveSettings set_;
   Teuchos::RCP<Impl> impl_;
-  long long setups_ = 0;
+  long long setups_ = 0, fallbacks_ = 0;
+  bool jacobi_ = false;  // the current matrix's preconditioner is Jacobi
 };
 
 }  // namespace mupm
