@@ -294,11 +294,12 @@ TEST(PressureProjection, CheckerboardIsHeldByThePressureStabilization3D) {
   check_checkerboard<3>();
 }
 
-// An ILU(0) breakdown (include/mupm/solvers/linear_solve.hpp): blocks [[1,1,0],[1,1,1],[0,1,1]],
-// nonsingular with a unit diagonal, whose factorization without pivoting meets a zero pivot in
-// its second row (1 - 1 * 1), one block per rank on 2 ranks. The solve falls back to Jacobi and
-// reaches x = (1, 2, 3) per block, computed here; without the fallback the residual is NaN.
-TEST(LinearSolve, IluBreakdownFallsBackToJacobi) {
+// An ILU(0) breakdown of the pressure solve (include/mupm/solvers/linear_solve.hpp): blocks
+// [[1,1,0],[1,1,1],[0,1,1]], nonsingular with a unit diagonal, whose factorization without
+// pivoting meets a zero pivot in its second row (1 - 1 * 1), one block per rank on 2 ranks. The
+// solve falls back to Jacobi and reaches x = (1, 2, 3) per block, computed here; without the
+// fallback the residual is NaN.
+TEST(PressureProjectionSolve, IluBreakdownFallsBackToJacobi) {
   const GlobalId n = 6;
   auto map = Teuchos::rcp(new Map(Tpetra::global_size_t(n), 0, test::world()));
   auto a = Teuchos::rcp(new CrsMatrix(map, 3));

@@ -239,7 +239,7 @@ class FractureFlow {
         if (bcs_[k].kind == BoundaryCondition::FracturePressure && in(bcs_[k], i))
           held = int(k);
       shared_(i, 0) = 1;
-      shared_(i, 1) = held;
+      shared_(i, 1) = held + 1;  // 0: none, as off the network
       shared_(i, 2) = nd.pold;
       net_.push_back(nd);
     }
@@ -250,7 +250,7 @@ class FractureFlow {
     return bc.region_mask == 0 || (disc_.points.regions(i) & bc.region_mask);
   }
   bool on(LocalId j) const { return shared_(j, 0) != 0; }
-  int held(LocalId j) const { return int(shared_(j, 1)); }
+  int held(LocalId j) const { return int(shared_(j, 1)) - 1; }  // -1: none
 
   // A Fracture Source's rate q [m^3/s] at t; an error when it injects (q != 0) but its region
   // holds no fracture point (volume vsum, all ranks), the same on every rank.
@@ -583,7 +583,7 @@ class FractureFlow {
   LinearSolve solver_;
   std::vector<BoundaryCondition> bcs_;
   std::vector<double> inflow_;
-  Vectors shared_;   // [points][3]: on the network, held condition, p_f^n (collect)
+  Vectors shared_;   // [points][3]: on the network, held condition + 1, p_f^n (collect)
   Vectors coupled_;  // [points][2]: conductance kappa, start value x0 (assemble)
   // The owned network points and their rows.
   std::vector<Node> net_;

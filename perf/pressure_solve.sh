@@ -1,0 +1,117 @@
+#!/usr/bin/env bash
+# The semi-implicit pressure solve's cost (Solver->Pressure Integration = Semi-Implicit,
+# include/mupm/solvers/pressure_projection.hpp): GMRES iterations per step, time per step of the
+# projection (its solve, its assembly) and its share of the whole step, from the run's kernel
+# timers (max over ranks) and time_series.csv, on 1 rank and on 2 ranks (1 thread each).
+#   perf/pressure_solve.sh MUPM [CASE...]   CASE: example1 | cube50 | cube100 (all by default)
+# example1: inputs/example1_deformation_driven.xml (Example 1 case 2, 100 x 100, delta = 3.015 dx)
+#   with incompressible water at the automatic (drained) step, 200 steps of the load's ramp.
+# cube50: a saturated 3D cube of 50^3 points, delta = 3.015 dx, incompressible, base fixed, top
+#   drained and pressed at 1 cm/s, 10 steps. cube100: the same at 100^3 = 1e6 points with
+#   delta = 1.5 dx (at 3.015 dx the projection's matrix, two horizons wide, would hold ~920
+#   entries a row: 11 GB at 1e6 points, and its ILU as much: beyond this machine's 24 GiB).
+# Writes into a temporary folder; prints one table row per case and rank count.
+set -euo pipefail
+MUPM=$(realpath "$1")
+shift
+SRC=$(cd "$(dirname "$0")/.." && pwd)
+PY=/usr/bin/python3
+cases=("$@")
+((${#cases[@]})) || cases=(example1 cube50 cube100)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+
+example1() {  # example1 FOLDER
+  sed -E -e 's|<Parameter name="Time Step" type="double" value="[^"]*"/>|<Parameter name="Automatic Time Step" type="bool" value="true"/><Parameter name="Pressure Integration" type="string" value="Semi-Implicit"/>|' \
+    -e 's|<Parameter name="Number of Steps" type="int" value="[0-9]+"/>|<Parameter name="Number of Steps" type="int" value="200"/>|' \
+    -e 's|(<Parameter name="Fluid Bulk Modulus"[^>]*>)|\1<Parameter name="Incompressible" type="bool" value="true"/>|' \
+    -e "s|<Parameter name=\"Folder\" type=\"string\" value=\"[^\"]*\"/>|<Parameter name=\"Folder\" type=\"string\" value=\"$1\"/>|" \
+    -e 's#name="(Field|Checkpoint) Interval" type="int" value="[0-9]+"#name="\1 Interval" type="int" value="0"#' \
+    -e 's|name="Time Series Interval" type="int" value="[0-9]+"|name="Time Series Interval" type="int" value="1"|' \
+    "$SRC/inputs/example1_deformation_driven.xml"
+}
+cube() {  # cube FOLDER N HORIZON STEPS
+  local fix="" comp
+  for comp in x y z; do
+    fix+="<ParameterList name=\"base $comp\"><Parameter name=\"Type\" type=\"string\" value=\"Displacement\"/><Parameter name=\"Region\" type=\"string\" value=\"Layer -z\"/><Parameter name=\"Component\" type=\"string\" value=\"$comp\"/></ParameterList>"
+  done
+  cat <<XML
+<ParameterList name="mupm">
+  <ParameterList name="Discretization">
+    <Parameter name="Dimension" type="int" value="3"/>
+    <Parameter name="Spacing" type="double" value="0.01"/>
+    <Parameter name="Counts" type="Array(int)" value="{$2, $2, $2}"/>
+    <Parameter name="Horizon Factor" type="double" value="$3"/>
+    <Parameter name="Boundary Layers" type="Array(string)" value="{-z, +z}"/>
+  </ParameterList>
+  <ParameterList name="Materials">
+    <Parameter name="Bulk Modulus" type="double" value="10e6"/>
+    <Parameter name="Shear Modulus" type="double" value="6e6"/>
+    <Parameter name="Micropolar Shear Modulus" type="double" value="3e6"/>
+    <Parameter name="Length Scale" type="double" value="0.01"/>
+    <Parameter name="Solid Density" type="double" value="2000"/>
+    <Parameter name="Porosity" type="double" value="0.3"/>
+  </ParameterList>
+  <ParameterList name="Fluid">
+    <Parameter name="Water Density" type="double" value="1000"/>
+    <Parameter name="Fluid Bulk Modulus" type="double" value="2.2e9"/>
+    <Parameter name="Incompressible" type="bool" value="true"/>
+    <Parameter name="Hydraulic Conductivity" type="double" value="5.11e-5"/>
+  </ParameterList>
+  <ParameterList name="Boundary Conditions">
+    $fix
+    <ParameterList name="drain"><Parameter name="Type" type="string" value="Pore Pressure"/><Parameter name="Region" type="string" value="Layer +z"/></ParameterList>
+    <ParameterList name="press"><Parameter name="Type" type="string" value="Velocity"/><Parameter name="Region" type="string" value="Layer +z"/><Parameter name="Component" type="string" value="z"/><Parameter name="Value" type="double" value="-0.01"/></ParameterList>
+  </ParameterList>
+  <ParameterList name="Solver">
+    <Parameter name="Physics" type="string" value="Hydro-Mechanical"/>
+    <Parameter name="Automatic Time Step" type="bool" value="true"/>
+    <Parameter name="Pressure Integration" type="string" value="Semi-Implicit"/>
+    <Parameter name="Number of Steps" type="int" value="$4"/>
+  </ParameterList>
+  <ParameterList name="Output">
+    <Parameter name="Folder" type="string" value="$1"/>
+    <Parameter name="Field Interval" type="int" value="0"/>
+    <Parameter name="Checkpoint Interval" type="int" value="0"/>
+    <Parameter name="Time Series Interval" type="int" value="1"/>
+  </ParameterList>
+</ParameterList>
+XML
+}
+
+# it/step: GMRES iterations; solve ms: the projection per step without its assembly (once per
+# run here: no bond breaks); rest ms: the rest of the step (solid, fluid, output); share: the
+# projection's part of the step without the assembly.
+printf '%-9s %5s %8s %5s %7s %9s %9s %10s %6s\n' case ranks points steps "it/step" "solve ms" "rest ms" "assemble s" share
+for c in "${cases[@]}"; do
+  case $c in
+    example1) example1 "$c" >"$c.xml" ;;
+    cube50) cube "$c" 50 3.015 10 >"$c.xml" ;;
+    cube100) cube "$c" 100 1.5 5 >"$c.xml" ;;
+    *) echo "unknown case $c" >&2; exit 1 ;;
+  esac
+  for np in 1 2; do
+    rm -rf "$c"
+    OMP_NUM_THREADS=1 OMP_PROC_BIND=false mpirun --allow-run-as-root --bind-to none -np $np \
+      -x OMP_NUM_THREADS -x OMP_PROC_BIND "$MUPM" "$c.xml" >"$c-$np.out" 2>&1 ||
+      { tail -20 "$c-$np.out"; exit 1; }
+    "$PY" - "$c" "$np" "$c-$np.out" <<'PY'
+import csv, re, sys
+name, np_, out = sys.argv[1], sys.argv[2], open(sys.argv[3]).read()
+def region(label):  # max seconds over ranks, calls
+    m = re.search(r"^region\s+" + re.escape(label) + r"\s+(\d+)\s+\S+\s+(\S+)", out, re.M)
+    return (float(m.group(2)), int(m.group(1))) if m else (0.0, 0)
+step, steps = region("mupm::Solver::step")
+proj, _ = region("mupm::Pressure::projection")
+asm, nasm = region("mupm::Pressure::assemble")
+points = re.search(r"(\d+) points", out)
+rows = list(csv.DictReader(open(f"{name}/time_series.csv")))[1:]
+its = sum(float(r["pressure_solve_iterations"]) for r in rows) / max(1, len(rows))
+solve, rest = (proj - asm) / steps, (step - proj) / steps
+print("%-9s %5s %8s %5d %7.1f %9.1f %9.1f %10.2f %5.0f%%" % (
+    name, np_, points.group(1) if points else "?", steps, its, 1e3 * solve, 1e3 * rest, asm,
+    100 * solve / (solve + rest)))
+PY
+  done
+done
