@@ -1,11 +1,11 @@
 #include "mupm/io/hdf5_io.hpp"
 
+#include "mupm/core/collective.hpp"
 #include "mupm/core/error.hpp"
 
 #include <hdf5.h>
 
 #include <algorithm>
-#include <climits>
 #include <stdexcept>
 #include <type_traits>
 
@@ -111,36 +111,6 @@ void check_err(herr_t e, const std::string& what) {
 
 Handle make_plist(hid_t cls, const std::string& what) {
   return Handle(check_id(H5Pcreate(cls), what), H5Pclose);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Collective error agreement
-
-// Throws the same exception on every rank if `local_error` is non-empty on any rank; the message
-// is the one of the lowest failing rank, so all ranks report the same thing.
-void agree(MPI_Comm comm, const std::string& local_error) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  const bool failed = !local_error.empty();
-  int in[2] = {failed ? rank : INT_MAX, failed ? 1 : 0};
-  int out[2] = {0, 0};
-  MPI_Allreduce(in, out, 2, MPI_INT, MPI_MIN, comm);
-  const int first = out[0];
-  if (first == INT_MAX) {
-    return;
-  }
-  std::string msg = local_error;
-  long long len = static_cast<long long>(msg.size());
-  MPI_Bcast(&len, 1, MPI_LONG_LONG, first, comm);
-  msg.resize(static_cast<std::size_t>(len));
-  MPI_Bcast(msg.data(), static_cast<int>(len), MPI_CHAR, first, comm);
-  const bool all_failed = out[1] == 1;
-  int size = 1;
-  MPI_Comm_size(comm, &size);
-  if (!all_failed && size > 1) {
-    msg += " [on rank " + std::to_string(first) + "]";
-  }
-  throw CollectiveError(msg);  // every rank throws it: the caller can stop cleanly
 }
 
 // Runs a local step and agrees on its outcome, so a failure on one rank cannot leave the others

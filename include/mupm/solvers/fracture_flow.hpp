@@ -103,6 +103,7 @@
 #include <utility>
 #include <vector>
 
+#include "mupm/core/collective.hpp"
 #include "mupm/core/error.hpp"
 #include "mupm/kernels/boundary_conditions.hpp"
 #include "mupm/kernels/fluid.hpp"
@@ -264,23 +265,6 @@ class FractureFlow {
     return q;
   }
 
-  // Throws on every rank the message of the lowest rank that has one.
-  void collective_throw(const std::string& mine) const {
-    int rank = 0, size = 1;
-    MPI_Comm_rank(comm_, &rank);
-    MPI_Comm_size(comm_, &size);
-    int root = mine.empty() ? size : rank;
-    MPI_Allreduce(MPI_IN_PLACE, &root, 1, MPI_INT, MPI_MIN, comm_);
-    if (root == size)
-      return;
-    std::string text = mine;
-    int len = int(text.size());
-    MPI_Bcast(&len, 1, MPI_INT, root, comm_);
-    text.resize(std::size_t(len));
-    MPI_Bcast(&text[0], len, MPI_CHAR, root, comm_);
-    throw CollectiveError(text);
-  }
-
   // The rows of the owned network points (header): adjacency, conductances, diagonal,
   // right-hand side; the sources at t, the prescribed p_f at t + dt.
   void assemble(double t, double dt) {
@@ -430,7 +414,7 @@ class FractureFlow {
       rhs_[k] = v * storage_[k] / dt * nd.pold + v * gexch_[k] * nd.phat - v * opening_[k] / dt +
                 source_[k];
     }
-    collective_throw(bad);
+    agree(comm_, bad);
   }
 
   // The increment y = p_f - x0 of the free rows (header): A y = rhs - A_full x0, held rows
@@ -449,7 +433,6 @@ class FractureFlow {
       longest = std::max(longest, adj_first_[k + 1] - adj_first_[k] + 1);
     auto a = Teuchos::rcp(new CrsMatrix(map, longest));
     TpetraVector rhs(map), y(map);
-    double norm = 0;  // ||D x0||: the round-off scale of A x (header)
     {
       auto bv = rhs.getLocalViewHost(Tpetra::Access::OverwriteAll);
       auto yv = y.getLocalViewHost(Tpetra::Access::OverwriteAll);
@@ -474,7 +457,6 @@ class FractureFlow {
                               Teuchos::ArrayView<const double>(vals));
         bv(k, 0) = free ? r : 0.0;
         yv(k, 0) = free && !net_[k].fresh ? p.pf_rate(i) * dt : 0.0;
-        norm += free ? diag_[k] * x0 * diag_[k] * x0 : 0.0;
       }
     }
     a->fillComplete(map, map);
@@ -482,21 +464,28 @@ class FractureFlow {
     // The tolerance is relative to ||D x|| at the solution; that of the start value is tried
     // first, and when the solution is larger (water let into a network at rest), the solve
     // goes on from where it stopped with the solution's.
-    auto scaled = [&](const TpetraVector& v) {
-      auto vv = v.getLocalViewHost(Tpetra::Access::ReadOnly);
+    // ||D x|| over the free rows, x = x0 + v (v = nullptr: x0): the round-off scale of A x.
+    auto scaled = [&](const TpetraVector* v) {
+      std::vector<double> dv(n, 0.0);
+      if (v) {
+        auto vv = v->getLocalViewHost(Tpetra::Access::ReadOnly);
+        for (std::size_t k = 0; k < n; ++k)
+          dv[k] = vv(k, 0);
+      }
       double s = 0;
       for (std::size_t k = 0; k < n; ++k)
-        if (held(net_[k].i) < 0)
-          s += std::pow(diag_[k] * (coupled_(net_[k].i, 1) + vv(k, 0)), 2);
+        if (held(net_[k].i) < 0) {
+          const double t = diag_[k] * (coupled_(net_[k].i, 1) + dv[k]);
+          s += t * t;
+        }
       MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
       return std::sqrt(s);
     };
-    MPI_Allreduce(MPI_IN_PLACE, &norm, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    double scale = std::sqrt(norm);
+    double scale = scaled(nullptr);
     LinearSolveResult res = solver_.solve(rhs, y, scale);
     last_iterations_ = res.iterations;
     if (!res.converged) {
-      double again = scaled(y);
+      double again = scaled(&y);
       if (again > scale) {
         res = solver_.solve(rhs, y, again);
         last_iterations_ += res.iterations;
