@@ -3,7 +3,10 @@
 # Trilinos), configure mupm in ./build, build what the command uses, then
 #   bash cmake/bootstrap.sh quickstart   build mupm alone, run inputs/quickstart.xml on 2 ranks
 #                                        (build/quickstart)
-#   bash cmake/bootstrap.sh test         build mupm and its tests, run every test (ctest)
+#   bash cmake/bootstrap.sh test         build mupm and its tests, run every test but the slow
+#                                        tier (ctest -LE slow)
+#   bash cmake/bootstrap.sh slow         build mupm and its tests, run the slow tier (ctest -L
+#                                        slow: minutes-long accuracy runs; .ci/run runs it)
 #   bash cmake/bootstrap.sh build        build everything (mupm, tests, benchmarks)
 #   bash cmake/bootstrap.sh sanitize     build mupm and its tests with ASan + UBSan in
 #                                        ./build-sanitize instead and run the tests labelled
@@ -12,9 +15,9 @@
 set -euo pipefail
 what=${1:-build}
 case "$what" in
-  build | quickstart | test | sanitize) ;;
+  build | quickstart | test | slow | sanitize) ;;
   *)
-    echo "usage: bash cmake/bootstrap.sh [build|quickstart|test|sanitize]" >&2
+    echo "usage: bash cmake/bootstrap.sh [build|quickstart|test|slow|sanitize]" >&2
     exit 1
     ;;
 esac
@@ -59,7 +62,7 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" >bu
 rm -f build-configure.log
 case "$what" in
   quickstart) targets=(mupm) ;;
-  test) targets=("${test_targets[@]}") ;;
+  test | slow) targets=("${test_targets[@]}") ;;
   *) targets=(all) ;;
 esac
 cmake --build build -j"$jobs" --target "${targets[@]}"
@@ -85,7 +88,11 @@ case "$what" in
     stage run
     ;;
   test)
-    ctest --test-dir build --output-on-failure -j"$jobs"
+    ctest --test-dir build --output-on-failure -j"$jobs" -LE slow
+    stage ctest
+    ;;
+  slow)
+    ctest --test-dir build --output-on-failure -j"$jobs" -L slow
     stage ctest
     ;;
 esac
