@@ -374,14 +374,16 @@ RCP<ParameterList> valid_parameters() {
           "true: water in the cracks (Solver->Physics = Hydro-Mechanical). The fracture "
           "points carry a fracture pressure p_f that flows along the crack by the cubic law "
           "a^3/(12 mu_w) (mu_w = Fluid->Viscosity), exchanges water with the pores (eq 19) and "
-          "pushes the crack's faces apart; solved implicitly every fluid step. Conditions: "
+          "pushes the crack's faces apart; solved implicitly every fluid step (Semi-Implicit: in "
+          "the pore pressure's solve). Conditions: "
           "Fracture Pressure, Fracture Source. Derivations in "
           "include/mupm/kernels/fracture_flow.hpp.");
     f.set("Crack Water Force", std::string("Face Pressure"),
           "How the crack's water pressure p_f acts on the solid (Fracture Flow). Face "
           "Pressure: p_f pushes the crack's faces apart (central pair forces on the broken "
           "bonds, p_f per unit face area), with the undrained p_f* of the opening the solid is "
-          "at. Eq 17: as the paper prints it, bonds between two fracture points carry -S_rf p_f "
+          "at (Explicit; Semi-Implicit: the p_f of the joint solve). Eq 17 (Explicit only): as the "
+          "paper prints it, bonds between two fracture points carry -S_rf p_f "
           "K^-1 xi in place of -S_r p K^-1 xi; those bonds run along the faces, so p_f barely "
           "acts across the crack (and p_f is that of the last fluid step). Derivations and why "
           "in include/mupm/kernels/fracture_flow.hpp.",
@@ -389,8 +391,9 @@ RCP<ParameterList> valid_parameters() {
     f.set("Minimum Aperture", 1e-6,
           "a_min [m]: a film of water in the crack (the paper gives none). The conductance "
           "takes max(a, a_min); the storage the crack's volume a + a_min, whose opening stores "
-          "water. The crack water's stiffness K_w / a_min enters the solid's stable step: a "
-          "small a_min (with a stiff water) means a small step. With Fracture Flow, below Spacing "
+          "water. Explicit: the crack water's stiffness K_w / a_min enters the solid's stable "
+          "step, a small a_min (with a stiff water) means a small step (not Semi-Implicit). With "
+          "Fracture Flow, below Spacing "
           "(the film fits in a "
           "crack point's cell).",
           positive());
@@ -471,7 +474,9 @@ RCP<ParameterList> valid_parameters() {
           "step (Pressure Solve) for the pressure at the step's end, with the volume change it "
           "gives the skeleton within the step (a pressure projection, include/mupm/solvers/"
           "pressure_projection.hpp): the step is the drained skeleton's, any K_w (Fluid->"
-          "Incompressible), no fluid substeps. Refused for now: Fracture Flow, Fluid Flux, and "
+          "Incompressible), no fluid substeps; with Fracture Flow the fracture pressure is in the "
+          "same solve (no K_w / a_min limit). Refused for now: Crack Water Force = Eq 17, "
+          "Fluid Flux, and "
           "Staggering, Solid Steps Per Fluid Step, Fluid Substeps other than Solid First, 1, 1.",
           pressure_integration_options().validator());
     s.set("Pressure Stabilization", 1.0,
@@ -1237,9 +1242,17 @@ static void check_pressure_integration(const ParameterList& input) {
   if (physics_options()(solver.get<std::string>("Physics")) != Physics::HydroMechanical)
     throw InputError("Error, " + have + "couples the pore pressure with the skeleton: it needs " +
                      root + "->Solver->Physics = Hydro-Mechanical.");
-  if (input.sublist("Fracture").get<bool>("Fracture Flow"))
-    throw InputError("Error, " + have + "does not solve the fracture network's pressure yet: " +
-                     root + "->Fracture->Fracture Flow must be false (or use Explicit).");
+  // The crack water's force enters the joint solve as the transpose of the crack volume's
+  // Jacobian (pressure_projection.hpp); eq 17's force on the fracture bonds has no such pair.
+  const ParameterList& fracture = input.sublist("Fracture");
+  if (fracture.get<bool>("Fracture Flow") &&
+      crack_water_force_options()(fracture.get<std::string>("Crack Water Force")) !=
+          CrackWaterForce::FacePressure)
+    throw InputError("Error, " + have +
+                     "solves the crack water's pressure with the face force "
+                     "it does work through: " +
+                     root +
+                     "->Fracture->Crack Water Force must be Face Pressure (or use Explicit).");
   // Fluid Flux (an even image of the body's pressure in the layer): measured unstable with
   // incompressible water (inputs/consolidation.xml, mirrored layers, K_h / 100, the top drain a
   // Fluid Flux of 1e-6 m/s: the solid diverged at step 2130). Mirrored Pore Pressure layers

@@ -63,8 +63,59 @@ print("water mass error %.2e of %.4g kg; solid energy error %.2e J of %.3g J; fl
       % (error, mass, float(last["energy_error"]), work, float(last["fluid_energy_error"])))
 PY
 
+# With fracture flow (the crack water's pressure in the same solve): Example 1 case 1 at 66 x 66
+# with incompressible water, 40 steps at the drained automatic step; the same checks, and the
+# crack water's balance.
+ff_input() {  # FOLDER STEPS RESTART
+  sed -E -e "s|<Parameter name=\"Physics\" type=\"string\" value=\"Hydro-Mechanical\"/>|&<Parameter name=\"Pressure Integration\" type=\"string\" value=\"Semi-Implicit\"/>|" \
+    -e "s|(<Parameter name=\"Fluid Bulk Modulus\"[^>]*>)|\1<Parameter name=\"Incompressible\" type=\"bool\" value=\"true\"/>|" \
+    -e "s|<Parameter name=\"End Time\" type=\"double\" value=\"0.5\"/>|<Parameter name=\"Number of Steps\" type=\"int\" value=\"$2\"/><Parameter name=\"Restart From\" type=\"string\" value=\"$3\"/>|" \
+    -e "s|<Parameter name=\"Folder\" type=\"string\" value=\"[^\"]*\"/>|<Parameter name=\"Folder\" type=\"string\" value=\"$1\"/>|" \
+    -e "s|<Parameter name=\"(Field\|Checkpoint) Interval\" type=\"int\" value=\"[0-9]+\"/>|<Parameter name=\"\1 Interval\" type=\"int\" value=\"0\"/>|" \
+    -e "s|<Parameter name=\"Time Series Interval\" type=\"int\" value=\"[0-9]+\"/>|<Parameter name=\"Time Series Interval\" type=\"int\" value=\"1\"/>|" \
+    "$SRC/inputs/example1_fluid_driven_66.xml"
+}
+ff_input ff_straight 40 "" >ff_straight.xml
+ff_input ff_first 20 "" >ff_first.xml
+ff_input ff_second 40 ff_first/checkpoint.h5 >ff_second.xml
+ff_input ff_threads 40 "" >ff_threads.xml
+for k in 'value="Semi-Implicit"' '"Incompressible"' '"Restart From"' 'Checkpoint Interval" type="int" value="0"'; do
+  grep -q "$k" ff_straight.xml || fail "inputs/example1_fluid_driven_66.xml changed: ff_straight.xml lacks $k"
+done
+for c in ff_straight ff_first ff_second; do
+  run 2 1 $c.xml >$c.out 2>&1 || { cat $c.out; fail "$c.xml did not run"; }
+done
+run 1 2 ff_threads.xml >ff_threads.out 2>&1 || { cat ff_threads.out; fail "ff_threads.xml did not run"; }
+grep -q "drained: the pore pressure is semi-implicit" ff_straight.out || { cat ff_straight.out; fail "not the drained step"; }
+"$PYTHON" - <<'PY'
+import csv, h5py, numpy as np
+with h5py.File("ff_straight/checkpoint.h5") as a, h5py.File("ff_second/checkpoint.h5") as b:
+    for field in a["points"]:
+        assert a["points"][field][...].tobytes() == b["points"][field][...].tobytes(), "restart: " + field
+    print("fracture flow, restart on 2 ranks: %d checkpoint fields equal bit for bit" % len(a["points"]))
+with h5py.File("ff_straight/checkpoint.h5") as a, h5py.File("ff_threads/checkpoint.h5") as b:
+    for field in ("pore_pressure", "fracture_pressure", "displacement"):  # in global-id order
+        x, y = a["points"][field][...], b["points"][field][...]
+        scale = np.abs(x).max()
+        diff = np.abs(x - y).max() / scale
+        print("fracture flow, 2 ranks x 1 thread vs 1 rank x 2 threads: %s differs by %.2e of its largest value" % (field, diff))
+        assert scale > 0 and diff < 1e-8, field
+rows = list(csv.DictReader(open("ff_straight/time_series.csv")))
+last = rows[-1]
+water = float(last["fluid_mass"]) + float(last["fracture_fluid_mass"])
+injected = float(last["fluid_inflow_injection"])
+assert injected > 0 and float(last["fracture_fluid_mass"]) > 0.5 * injected
+assert abs(float(last["fluid_mass_error"])) < 1e-10 * water, ("water mass", last["fluid_mass_error"])
+scale = max(abs(float(r["fracture_fluid_skeleton_work"])) for r in rows)
+assert abs(float(last["fracture_fluid_energy_error"])) < 1e-10 * scale, ("crack water", last["fracture_fluid_energy_error"])
+fluid = max(abs(float(r["fluid_coupling_work"])) for r in rows)
+assert abs(float(last["fluid_energy_error"])) < 1e-8 * max(fluid, scale), ("fluid energy", last["fluid_energy_error"])
+print("fracture flow: water error %.2e of %.4g kg, injected %.3g kg; crack water balance %.2e J of %.3g J"
+      % (float(last["fluid_mass_error"]), water, injected, float(last["fracture_fluid_energy_error"]), scale))
+PY
+
 # Refused by name: incompressible water without the semi-implicit scheme, and what the scheme
-# does not have (fracture flow) or does not use (staggering, sub-cycling), and its physics.
+# does not have (eq 17's crack water force) or does not use (staggering, sub-cycling), and its physics.
 hm='<Parameter name="Physics" type="string" value="Hydro-Mechanical"/>'
 si='<Parameter name="Pressure Integration" type="string" value="Semi-Implicit"/>'
 pores='<Parameter name="Porosity" type="double" value="0.3"/>'
@@ -76,8 +127,8 @@ base '' "$hm$si<Parameter name=\"Fluid Substeps\" type=\"int\" value=\"0\"/>" | 
 expect si_substeps 2 'mupm->Solver->Pressure Integration = Semi-Implicit' 'Fluid Substeps are for Explicit'
 base '' "$si" >si_solid.xml
 expect si_solid 2 'mupm->Solver->Pressure Integration = Semi-Implicit' 'Physics = Hydro-Mechanical'
-base '' "$hm$si" | sed -e "s|<ParameterList name=\"Solver\">|<ParameterList name=\"Fracture\"><Parameter name=\"Fracture Flow\" type=\"bool\" value=\"true\"/></ParameterList>$fluid&|" -e "s|<Parameter name=\"Bulk Modulus\"|$pores&|" >si_fracture_flow.xml
-expect si_fracture_flow 2 'mupm->Solver->Pressure Integration = Semi-Implicit' 'Fracture->Fracture Flow must be false'
+base '' "$hm$si" | sed -e "s|<ParameterList name=\"Solver\">|<ParameterList name=\"Fracture\"><Parameter name=\"Fracture Flow\" type=\"bool\" value=\"true\"/><Parameter name=\"Crack Water Force\" type=\"string\" value=\"Eq 17\"/></ParameterList>$fluid&|" -e "s|<Parameter name=\"Bulk Modulus\"|$pores&|" >si_eq17.xml
+expect si_eq17 2 'mupm->Solver->Pressure Integration = Semi-Implicit' 'Fracture->Crack Water Force must be Face Pressure'
 sed -e 's|<Parameter name="Type" type="string" value="Pore Pressure"/>|<Parameter name="Type" type="string" value="Fluid Flux"/>|' straight.xml >si_flux.xml
 grep -q 'value="Fluid Flux"' si_flux.xml || fail "si_flux.xml not derived"
 expect si_flux 2 'mupm->Solver->Pressure Integration = Semi-Implicit does not take mupm->Boundary Conditions->' '->Type = Fluid Flux yet'

@@ -99,6 +99,8 @@ class FluidSolver : public Module {
   // this bulk by the exchange of eq 19 in every substep; takes the Fracture conditions.
   void enable_fracture_flow(const FractureParams& prm) {
     fracture_ = std::make_unique<FractureFlow<Dim>>(disc_, prm_, prm, all_bcs_, comm_);
+    if (semi_implicit_)
+      fracture_->set_implicit();
     phat_ = Scalars("mupm::bulk_predictor", disc_.points.n_owned);
     sink_ = Scalars("mupm::fracture_exchange", disc_.points.n_owned);
   }
@@ -284,7 +286,7 @@ class FluidSolver : public Module {
       throw std::logic_error(
           "FluidSolver: semi-implicit pressure without FluidParams::semi_implicit");
     if (fracture_)
-      throw std::logic_error("FluidSolver: the semi-implicit pressure has no fracture flow yet");
+      fracture_->set_implicit();
     solve_settings_ = settings;
     semi_implicit_ = true;
     const std::size_t n = disc_.points.n_owned;
@@ -315,8 +317,12 @@ class FluidSolver : public Module {
     Kokkos::deep_copy(c_old_, st_.storage);
     Kokkos::deep_copy(sr_old_, Kokkos::subview(p.saturation, owned));
     Kokkos::deep_copy(flow_old_, st_.flow);
+    CrackBlock crack;  // the fracture network's rows (fracture_flow.hpp), empty without one
+    if (fracture_)
+      fracture_->implicit_rows(t, dt, projection_->crack_offset(), crack);
+    std::vector<double> dpf;
     const auto r = projection_->step(dt, prm_, st_, source_, target, skeleton.skeleton_state(), dp_,
-                                     solve_scale_);
+                                     solve_scale_, crack, dpf);
     stats_ = {double(r.iterations), r.residual, double(projection_->assemblies())};
     if (!r.converged) {
       std::ostringstream m;
@@ -338,6 +344,14 @@ class FluidSolver : public Module {
           pw(i) += dp(i);
           rate(i) = dp(i) / dt;
         });
+    if (fracture_) {  // p_f, and the exchange the bulk lost: a sink in its bookkeeping
+      fracture_->implicit_finish(dt, dpf, sink_);
+      fracture_->implicit_opening();
+      auto src = source_, sink = sink_;
+      Kokkos::parallel_for(
+          "mupm::Fluid::exchange", range(0, p.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i) { src(i) -= sink(i); });
+    }
     evaluate();
   }
 

@@ -35,6 +35,12 @@
 // p_f* = p_f - M_f (c - c_ref) at the opening it is at (kernels header), and its stable-step
 // estimate includes it (solvers/solid_solver.hpp); hence a_min also bounds the time step.
 //
+// Pressure Integration = Semi-Implicit: p_f is solved together with the bulk's p instead
+// (implicit_rows, implicit_finish, implicit_opening; the joint system is derived in
+// include/mupm/solvers/pressure_projection.hpp): the exchange is implicit on both sides (G in
+// place of G'), M_f = 0 (the solid applies p_f itself) and the opening's work is booked with the
+// opening the step reached after the pressure's correction.
+//
 // The solve is distributed as the points are: each rank assembles the rows of its own fracture
 // points as a Tpetra CrsMatrix over the network's map (the owned fracture points' global ids),
 // its neighbours' data reaching it with the ghosts (two refreshes: on the network, held, p_f^n;
@@ -112,6 +118,7 @@
 #include "mupm/mesh/discretization.hpp"
 #include "mupm/solvers/linear_solve.hpp"
 #include "mupm/solvers/module.hpp"
+#include "mupm/solvers/pressure_system.hpp"
 
 namespace mupm {
 
@@ -199,6 +206,132 @@ class FractureFlow {
     assemble(t, dt);
     solve(dt);
     scatter(dt, sink);
+  }
+
+  // Pressure Integration = Semi-Implicit (include/mupm/solvers/pressure_projection.hpp): p_f
+  // comes from the pore pressure's solve, one joint system. The exchange is then implicit on
+  // both sides (G, not G'), and the solid applies p_f itself (M_f = 0: no undrained spring).
+  void set_implicit() { implicit_ = true; }
+  // The network's rows of the joint system for t -> t + dt (CrackBlock), at the skeleton's
+  // predicted displacement u* (refreshed onto the ghosts here) and the bulk's p^n.
+  void implicit_rows(double t, double dt, GlobalId offset, CrackBlock& blk) {
+    ScopedRegion region("mupm::FractureFlow::rows");
+    auto& p = disc_.points;
+    const auto& b = disc_.bonds;
+    blk = CrackBlock();
+    blk.offset = offset;
+    disc_.dist.refresh({p.u});
+    collect(p.p, p.p);
+    long long n = (long long)net_.size();
+    MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    last_size_ = n;
+    last_iterations_ = 0;
+    if (n == 0) {
+      for (const auto& bc : bcs_)
+        if (bc.kind == BoundaryCondition::FractureSource)
+          check_source(bc, t, 0.0);
+      return;
+    }
+    assemble(t, dt);
+    constexpr int NC = Dim + kRotDim<Dim>;
+    const VanGenuchten vg = fluid_.retention;
+    for (std::size_t k = 0; k < net_.size(); ++k) {
+      const Node& nd = net_[k];
+      const LocalId i = nd.i;
+      const double v = p.volume(i);
+      const bool h = held(i) >= 0;
+      blk.point.push_back(i);
+      blk.held.push_back(h ? 1 : 0);
+      blk.start.push_back(h ? held_value_[k] - nd.pold : (nd.fresh ? 0.0 : p.pf_rate(i) * dt));
+      blk.pf0.push_back(nd.pold);
+      blk.unfelt.push_back(nd.fresh ? nd.pold : 0.0);
+      blk.storage.push_back(v * storage_[k]);
+      blk.exchange.push_back(dt * v * gexch_[k]);
+      // The water balance at the increments' zero: the crack's opening to u*, the flows and the
+      // exchange at p^n, p_f^n, the sources.
+      double r = -v * opening_[k] + dt * source_[k] + dt * v * gexch_[k] * (nd.phat - nd.pold);
+      std::vector<std::pair<GlobalId, double>> flow;
+      for (std::size_t e = adj_first_[k]; e < adj_first_[k + 1]; ++e) {
+        r += dt * lambda_[e] * (shared_(adj_[e], 2) - nd.pold);
+        flow.push_back({offset + p.gid(adj_[e]), dt * lambda_[e]});
+      }
+      blk.rhs.push_back(r);
+      blk.flow.push_back(std::move(flow));
+      // B_f = S_rf A dc/du, c = sum_b w_b (u_j - u_i).n (eq 39; the kernels header): the crack
+      // face force's transpose.
+      std::vector<std::pair<GlobalId, double>> row;
+      double nn = 0;
+      for (int d = 0; d < Dim; ++d)
+        nn += nd.nrm[d] * nd.nrm[d];
+      if (prm_.face_pressure && nn > 0) {
+        double vsum = 0;
+        for (BondIndex e = b.offsets(i); e < b.offsets(i + 1); ++e)
+          if (!b.intact(e))
+            vsum += p.volume(b.neighbor(e));
+        const double s = vg.saturation(nd.pold) * v / (rows_[k] * disc_.grid.dx);
+        for (BondIndex e = b.offsets(i); e < b.offsets(i + 1); ++e) {
+          if (b.intact(e))
+            continue;
+          const LocalId j = b.neighbor(e);
+          for (int d = 0; d < Dim; ++d)
+            row.push_back({p.gid(j) * NC + d, s * p.volume(j) / vsum * nd.nrm[d]});
+        }
+        for (int d = 0; d < Dim; ++d)
+          row.push_back({p.gid(i) * NC + d, -s * nd.nrm[d]});
+      }
+      blk.coupling.push_back(std::move(row));
+    }
+  }
+  // After the joint solve: p_f = p_f^n + dpf (held: the prescribed value), the exchange with
+  // the bulk's new pressure (p, owned) into `sink` [1/s], contents and energies (the skeleton
+  // work in implicit_opening).
+  void implicit_finish(double dt, const std::vector<double>& dpf, const Scalars& sink) {
+    Kokkos::deep_copy(sink, 0.0);
+    if (last_size_ == 0)
+      return;
+    x_.assign(net_.size(), 0.0);
+    for (std::size_t k = 0; k < net_.size(); ++k) {
+      net_[k].phat = disc_.points.p(net_[k].i);
+      x_[k] = held(net_[k].i) >= 0 ? held_value_[k] : net_[k].pold + dpf[k];
+    }
+    scatter(dt, sink);
+  }
+  // After the pressure's correction of the skeleton (u_{n+1}, refreshed onto the ghosts here),
+  // before the skeleton's step breaks bonds: the crack's opening over the step with the bonds
+  // the solve used, its work on the skeleton and, on a held point, the water its reservoir
+  // supplied for it. (With the opening after breakage, the broken bonds' jump in the mean
+  // opening was booked as work the solve never saw: the crack water's balance lost 0.03 J at
+  // the first breakage in the KGD input.) The jump enters the next step's opening instead, as
+  // in the explicit scheme.
+  void implicit_opening() {
+    if (last_size_ == 0)
+      return;
+    auto& p = disc_.points;
+    disc_.dist.refresh({p.u});
+    const auto& b = disc_.bonds;
+    const VanGenuchten vg = fluid_.retention;
+    std::vector<double> sums(2 + bcs_.size(), 0.0);
+    for (std::size_t k = 0; k < net_.size(); ++k) {
+      const Node& nd = net_[k];
+      const LocalId i = nd.i;
+      const double v = p.volume(i), pm = 0.5 * (nd.pold + x_[k]);
+      const double open = mean_opening<Dim>(b.offsets, b.neighbor, b.intact, p.x, p.u, p.volume, i);
+      const double d = vg.saturation(nd.pold) * (open - nd.open_ref) / (rows_[k] * disc_.grid.dx);
+      sums[0] += pm * v * d;
+      const int h = held(i);
+      if (h >= 0) {  // the held point's storage equation, with the opening it reached
+        const double extra = v * (d - opening_[k]);
+        sums[2 + std::size_t(h)] += extra;
+        sums[1] += pm * extra;
+        p.pf_content(i) += extra / v;
+      }
+      p.pf_aperture(i) = open;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, sums.data(), int(sums.size()), MPI_DOUBLE, MPI_SUM, comm_);
+    energy_.skeleton_work += sums[0];
+    energy_.external_work += sums[1];
+    for (std::size_t c = 0; c < bcs_.size(); ++c)
+      inflow_[c] += fluid_.water_density * sums[2 + c];
   }
 
  private:
@@ -323,7 +456,8 @@ class FractureFlow {
       storage_[k] = phi_f_[k] * (vg.dsaturation_dp(nd.pold) + sat * inv_kw);
       opening_[k] = sat * (nd.open - nd.open_ref) / (rows * dx);  // S_rf d(phi_f)
       rows_[k] = rows;
-      gexch_[k] = nd.bulk_fixed ? nd.G : (nd.C > 0 ? nd.G * nd.C / (nd.C + dt * nd.G) : 0.0);
+      gexch_[k] =
+          nd.bulk_fixed || implicit_ ? nd.G : (nd.C > 0 ? nd.G * nd.C / (nd.C + dt * nd.G) : 0.0);
       floor = std::min(floor, v * (storage_[k] / dt + gexch_[k]));
     }
     // Conditioning: a wide-open crack's conductances exceed V C_f / dt by more than the 16
@@ -534,7 +668,8 @@ class FractureFlow {
       de[0] += v * phi_f_[k] *
                (stored_energy_density(vg, 1.0, inv_kw, x_[k]) -
                 stored_energy_density(vg, 1.0, inv_kw, pold));
-      de[1] += pm * v * opening_[k];
+      if (!implicit_)  // implicit: implicit_opening, with the opening the step reached
+        de[1] += pm * v * opening_[k];
       de[2] -= pm * dt * flow;
       de[3] += pm * dt * source_[k];
       de[4] += pm * exch;
@@ -547,12 +682,14 @@ class FractureFlow {
       }
       p.pf_rate(i) = (x_[k] - pold) / dt;
       p.pf_content(i) += gain / v;
-      p.pf_aperture(i) = nd.open;
+      if (!implicit_)
+        p.pf_aperture(i) = nd.open;
       p.pf_area(i) = v / (rows_[k] * disc_.grid.dx);  // A_i (kernels header)
       // The undrained modulus M_f = S_rf/(C_f n_i dx) of the solid's p_f* (kernels header):
-      // 0 on a point of prescribed p_f.
-      p.pf_modulus(i) =
-          h >= 0 ? 0.0 : vg.saturation(pold) / (storage_[k] * rows_[k] * disc_.grid.dx);
+      // 0 on a point of prescribed p_f, and in the semi-implicit scheme (p_f implicit).
+      p.pf_modulus(i) = h >= 0 || implicit_
+                            ? 0.0
+                            : vg.saturation(pold) / (storage_[k] * rows_[k] * disc_.grid.dx);
       sink(i) = exch / (dt * v);
     }
     MPI_Allreduce(MPI_IN_PLACE, sums.data(), int(sums.size()), MPI_DOUBLE, MPI_SUM, comm_);
@@ -583,6 +720,7 @@ class FractureFlow {
   std::vector<int> rows_;
   long long last_size_ = 0;
   int last_iterations_ = 0;
+  bool implicit_ = false;  // set_implicit
   Energy energy_;
 };
 

@@ -236,6 +236,75 @@ inline Teuchos::RCP<CrsMatrix> projection_operator(const CrsMatrix& coupling,
   return out;
 }
 
+// The fracture network's rows of the joint semi-implicit system (include/mupm/solvers/
+// fracture_flow.hpp, Pressure Integration = Semi-Implicit; derivation in pressure_projection.hpp),
+// written by the network each step. Joint numbering: a point's pore pressure is its gid, its
+// fracture pressure offset + gid. Per owned network point k (in `point` order):
+struct CrackBlock {
+  GlobalId offset = 0;         // the fracture pressures' gid offset (the points' count)
+  std::vector<LocalId> point;  // the point's local id
+  std::vector<char> held;      // p_f prescribed (Fracture Pressure): its increment is given
+  std::vector<double> start;   // held: the prescribed increment; free: the solve's first guess
+  std::vector<double> pf0;     // p_f^n [Pa] (the bulk's p^n for a point that joins now)
+  // The part of p_f^n whose face force the skeleton has not felt: p_f^n on a point that joins
+  // now (its face force starts with this step's correction), else 0 [Pa]
+  std::vector<double> unfelt;
+  std::vector<double> rhs;       // the free row's right-hand side at the increments' zero [m^3]
+  std::vector<double> storage;   // V C_f [m^3/Pa]
+  std::vector<double> exchange;  // dt V G, the implicit exchange with the bulk [m^3/Pa]
+  // dt Lambda_e to the network neighbours (joint gids) [m^3/Pa]
+  std::vector<std::vector<std::pair<GlobalId, double>>> flow;
+  // B_f: the crack volume's Jacobian S_rf A dc/d(u, theta) (component gids of
+  // component_map(disc, Dim + R, ...)) [m^2]; empty rows without the face pressure
+  std::vector<std::vector<std::pair<GlobalId, double>>> coupling;
+};
+
+namespace detail {
+// `a`'s rows (none: no rows) under their global ids, plus `extra` rows (global row, (global
+// column, value)), as a matrix over `rows` (which holds both) with the given domain and range.
+inline Teuchos::RCP<CrsMatrix> with_rows(
+    const CrsMatrix* a, const Teuchos::RCP<const Map>& rows,
+    const std::vector<std::pair<GlobalId, std::vector<std::pair<GlobalId, double>>>>& extra,
+    const Teuchos::RCP<const Map>& domain, const Teuchos::RCP<const Map>& range) {
+  std::size_t longest = a ? std::max<std::size_t>(1, a->getNodeMaxNumRowEntries()) : 1;
+  for (const auto& r : extra)
+    longest = std::max(longest, r.second.size());
+  auto out = Teuchos::rcp(new CrsMatrix(rows, longest));
+  std::vector<GlobalId> cols;
+  std::vector<double> vals;
+  const LocalId nrows = a ? LocalId(a->getRowMap()->getNodeNumElements()) : 0;
+  for (LocalId r = 0; r < nrows; ++r) {
+    const auto& arows = *a->getRowMap();
+    const auto& acols = *a->getColMap();
+    CrsMatrix::local_inds_host_view_type idx;
+    CrsMatrix::values_host_view_type v;
+    a->getLocalRowView(r, idx, v);
+    cols.resize(idx.extent(0));
+    vals.resize(idx.extent(0));
+    for (std::size_t k = 0; k < idx.extent(0); ++k) {
+      cols[k] = acols.getGlobalElement(idx(k));
+      vals[k] = v(k);
+    }
+    if (!cols.empty())
+      out->insertGlobalValues(arows.getGlobalElement(r), Teuchos::ArrayView<const GlobalId>(cols),
+                              Teuchos::ArrayView<const double>(vals));
+  }
+  for (const auto& r : extra) {
+    cols.clear();
+    vals.clear();
+    for (const auto& e : r.second) {
+      cols.push_back(e.first);
+      vals.push_back(e.second);
+    }
+    if (!cols.empty())
+      out->insertGlobalValues(r.first, Teuchos::ArrayView<const GlobalId>(cols),
+                              Teuchos::ArrayView<const double>(vals));
+  }
+  out->fillComplete(domain, range);
+  return out;
+}
+}  // namespace detail
+
 // A diagonal matrix over `map` with the values of `diag`.
 inline Teuchos::RCP<CrsMatrix> diagonal_matrix(const TpetraVector& diag) {
   const auto map = diag.getMap();

@@ -585,8 +585,9 @@ class SolidSolver : public Mechanics, public Skeleton {
     // point not yet in the network the modulus it will join with, K_w / a_min (saturated, closed:
     // a film a_min). The crack water's stiffness K_w / a_min is what limits the step of a
     // fluid-driven crack (Example 1 at 66 x 66, K_w = 2.2 GPa, a_min = 0.1 mm: stable at 0.4 us,
-    // unstable at 0.95 us, the skeleton's own limit being 1.9 us).
-    const bool crack = face_pressure();
+    // unstable at 0.95 us, the skeleton's own limit being 1.9 us). Semi-implicit: p_f comes from
+    // the pressure solve (M_f = 0, pressure_projection.hpp), the crack water adds no stiffness.
+    const bool crack = face_pressure() && !set_.semi_implicit;
     Scalars keep[5];
     if (crack) {
       Scalars fields[5] = {p.pf, p.pf_saturation, p.pf_modulus, p.pf_aperture, p.pf_area};
