@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Solver->Pressure Integration = Semi-Implicit from the command line (include/mupm/solvers/
-# pressure_projection.hpp), on the consolidation input with incompressible water:
+# pressure_projection.hpp), on the consolidation input with incompressible water, and on
+# Example 1 case 1 at 66 x 66 (fracture flow: the crack water's pressure in the same solve):
 #  - a restart on the same rank count continues bit for bit (fields and checkpoint);
 #  - 1 rank x 2 threads and 2 ranks x 1 thread agree to the pressure solve's tolerance (the
 #    Krylov iterates depend on the reductions' order and the preconditioner's subdomains);
-#  - the water mass and both energy balances close (time_series.csv);
+#  - the water mass and the energy balances close (time_series.csv; the crack water's too);
 #  - what it does not take is refused by name, by the run and by --validate.
 source "$(dirname "$0")/common.sh"
 source "$(dirname "$0")/error_cases.sh"
