@@ -111,6 +111,37 @@ std::pair<double, double> fit_pf_along_x(const Points<2>& p, std::uint32_t mask)
   return {a, (sp - a * sx) / n};
 }
 
+// Fluid with fracture flow (semi-implicit when fprm.semi_implicit), solid and damage on one
+// plate, initialized at t = 0, stepped by Algorithm 1's step sequence.
+struct CoupledCrack {
+  FluidSolver<2> fluid;
+  bool enabled;  // fracture flow (and the semi-implicit pressure) enabled before the solid
+  SolidSolver<2> solid;
+  Damage<2> damage;
+  StepSequence<2> seq;
+  CoupledCrack(Discretization<2>& disc, const GridSpec<2>& g, const FluidParams& fprm,
+               const MicropolarElastic& law, const SolidSolver<2>::Settings& set,
+               const std::vector<BoundaryCondition>& bcs)
+      : fluid(disc, fprm, bcs, MPI_COMM_WORLD),
+        enabled(enable(fluid, set, fprm.semi_implicit)),
+        solid(disc, solid_params(law, g, 0.5), bcs, set, MPI_COMM_WORLD),
+        damage(disc, set.fracture.critical_damage, MPI_COMM_WORLD),
+        seq{&solid, &fluid, &damage} {
+    fluid.initialize(0, false);
+    solid.initialize(0, false);
+    fluid.reset_strain_reference();
+    damage.update();
+    if (fprm.semi_implicit)
+      seq.skeleton = &solid;
+  }
+  static bool enable(FluidSolver<2>& f, const SolidSolver<2>::Settings& set, bool semi_implicit) {
+    f.enable_fracture_flow(set.fracture);
+    if (semi_implicit)
+      f.enable_semi_implicit(LinearSolveSettings());
+    return true;
+  }
+};
+
 // The network's solve (FractureFlow::solve_settings, include/mupm/solvers/linear_solve.hpp) on
 // the shape of its systems: a chain of n points with storage s and conductance c to the next two
 // (conductances 1e6 times the storage, as along an open crack), distributed over the ranks,
@@ -608,21 +639,13 @@ TEST(FractureFlow, CrackForceWorkMatchesTheCrackWaterWork) {
       condition(BoundaryCondition::FracturePressure, "crack", -1, p0)};
   Kokkos::deep_copy(s.disc.points.saturation, 1.0);
   Kokkos::deep_copy(s.disc.points.porosity, 0.2);
-  FluidSolver<2> fluid(s.disc, fprm, bcs, MPI_COMM_WORLD);
-  fluid.enable_fracture_flow(set.fracture);
-  SolidSolver<2> solid(s.disc, solid_params(law, s.g, 0.5), bcs, set, MPI_COMM_WORLD);
-  Damage<2> damage(s.disc, set.fracture.critical_damage, MPI_COMM_WORLD);
-  fluid.initialize(0, false);
-  solid.initialize(0, false);
-  fluid.reset_strain_reference();
-  damage.update();
-  StepSequence<2> seq{&solid, &fluid, &damage};
-  const double dt = 0.5 * solid.estimate_stable_dt();
+  CoupledCrack run(s.disc, s.g, fprm, law, set, bcs);
+  const double dt = 0.5 * run.solid.estimate_stable_dt();
   const int steps = 400;
   for (int n = 0; n < steps; ++n)
-    seq.step(n, n * dt, dt);
-  const double w_solid = solid.energy().crack_work;
-  const auto& fe = fluid.fracture_flow()->energy();
+    run.seq.step(n, n * dt, dt);
+  const double w_solid = run.solid.energy().crack_work;
+  const auto& fe = run.fluid.fracture_flow()->energy();
   const double ratio = w_solid / fe.skeleton_work;
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -715,20 +738,11 @@ TEST(FractureFlowSemiImplicit, IncompressibleCrackOpensByTheInjectedVolume) {
   bcs[0].time.kind = TimeFunction::Table;
   bcs[0].time.times = {0.0, 20 * dt};
   bcs[0].time.values = {0.0, 1.0};
-  FluidSolver<2> fluid(s.disc, fprm, bcs, MPI_COMM_WORLD);
-  fluid.enable_fracture_flow(set.fracture);
-  fluid.enable_semi_implicit(LinearSolveSettings());
-  SolidSolver<2> solid(s.disc, solid_params(law, s.g, 0.5), bcs, set, MPI_COMM_WORLD);
-  Damage<2> damage(s.disc, set.fracture.critical_damage, MPI_COMM_WORLD);
-  fluid.initialize(0, false);
-  solid.initialize(0, false);
-  fluid.reset_strain_reference();
-  damage.update();
-  StepSequence<2> seq{&solid, &fluid, &damage};
-  seq.skeleton = &solid;
+  CoupledCrack run(s.disc, s.g, fprm, law, set, bcs);
+  auto& fluid = run.fluid;
   const int steps = 100;
   for (int n = 0; n < steps; ++n)
-    seq.step(n, n * dt, dt);
+    run.seq.step(n, n * dt, dt);
   const auto& b = s.disc.bonds;
   const double crack = sum_owned(p, [&](std::size_t i) {
     return p.pf_saturation(i) > 0
@@ -742,7 +756,7 @@ TEST(FractureFlowSemiImplicit, IncompressibleCrackOpensByTheInjectedVolume) {
   for (int n = 0; n < steps; ++n)
     expected += q * s.g.thickness * std::min(1.0, n / 20.0) * dt;
   const auto& fe = ff->energy();
-  const auto e = solid.energy();
+  const auto e = run.solid.energy();
   const double water = fluid.fluid_mass() + ff->mass();
   const double water0 = fprm.water_density * 0.2 * s.L * s.H * s.g.thickness;
   int rank = 0;
@@ -802,17 +816,10 @@ TEST(FractureFlowSemiImplicit, CrackWaterBalanceHoldsThroughBreakage) {
       condition(BoundaryCondition::FractureSource, "mouth", 0, 1e-3)};
   Kokkos::deep_copy(p.saturation, 1.0);
   Kokkos::deep_copy(p.porosity, 0.2);
-  FluidSolver<2> fluid(disc, fprm, bcs, MPI_COMM_WORLD);
-  fluid.enable_fracture_flow(set.fracture);
-  fluid.enable_semi_implicit(LinearSolveSettings());
-  SolidSolver<2> solid(disc, solid_params(law, g, 0.5), bcs, set, MPI_COMM_WORLD);
-  Damage<2> damage(disc, set.fracture.critical_damage, MPI_COMM_WORLD);
-  fluid.initialize(0, false);
-  solid.initialize(0, false);
-  fluid.reset_strain_reference();
-  damage.update();
-  StepSequence<2> seq{&solid, &fluid, &damage};
-  seq.skeleton = &solid;
+  CoupledCrack run(disc, g, fprm, law, set, bcs);
+  auto& fluid = run.fluid;
+  auto& solid = run.solid;
+  auto& seq = run.seq;
   const double dt = 0.5 * solid.estimate_stable_dt();
   const long long broken0 = solid.broken_pairs();
   const double water0 = fluid.fluid_mass();

@@ -191,18 +191,8 @@ class FractureFlow {
   void step(double t, double dt, const Scalars& phat, const Scalars& C, const Scalars& sink) {
     ScopedRegion region("mupm::FractureFlow::step");
     Kokkos::deep_copy(sink, 0.0);
-    collect(phat, C);
-    long long n = (long long)net_.size();
-    MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, comm_);
-    last_size_ = n;
-    last_iterations_ = 0;
-    if (n == 0) {
-      // No fracture point anywhere (yet): a Fracture Source has nowhere to put its water.
-      for (const auto& bc : bcs_)
-        if (bc.kind == BoundaryCondition::FractureSource)
-          check_source(bc, t, 0.0);
+    if (!gather(t, phat, C))
       return;
-    }
     assemble(t, dt);
     solve(dt);
     scatter(dt, sink);
@@ -221,17 +211,8 @@ class FractureFlow {
     blk = CrackBlock();
     blk.offset = offset;
     disc_.dist.refresh({p.u});
-    collect(p.p, p.p);
-    long long n = (long long)net_.size();
-    MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, comm_);
-    last_size_ = n;
-    last_iterations_ = 0;
-    if (n == 0) {
-      for (const auto& bc : bcs_)
-        if (bc.kind == BoundaryCondition::FractureSource)
-          check_source(bc, t, 0.0);
+    if (!gather(t, p.p, p.p))
       return;
-    }
     assemble(t, dt);
     constexpr int NC = Dim + kRotDim<Dim>;
     const VanGenuchten vg = fluid_.retention;
@@ -378,6 +359,22 @@ class FractureFlow {
       net_.push_back(nd);
     }
     disc_.dist.refresh({shared_});
+  }
+
+  // collect(), then the network's size over the ranks: false (on every rank) when it is empty,
+  // after checking that no Fracture Source injects then (it would have nowhere to put its
+  // water).
+  bool gather(double t, const Scalars& phat, const Scalars& C) {
+    collect(phat, C);
+    long long n = (long long)net_.size();
+    MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    last_size_ = n;
+    last_iterations_ = 0;
+    if (n == 0)
+      for (const auto& bc : bcs_)
+        if (bc.kind == BoundaryCondition::FractureSource)
+          check_source(bc, t, 0.0);
+    return n > 0;
   }
 
   bool in(const BoundaryCondition& bc, std::size_t i) const {
