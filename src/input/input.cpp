@@ -385,7 +385,9 @@ RCP<ParameterList> valid_parameters() {
           "at (Explicit; Semi-Implicit: the p_f of the joint solve). Eq 17 (Explicit only): as the "
           "paper prints it, bonds between two fracture points carry -S_rf p_f "
           "K^-1 xi in place of -S_r p K^-1 xi; those bonds run along the faces, so p_f barely "
-          "acts across the crack (and p_f is that of the last fluid step). Derivations and why "
+          "acts across the crack (and p_f is that of the last fluid step); its force does work "
+          "the crack water does not supply, and with injection it blows up at any time step "
+          "(inputs/README.md, Example 1). Derivations and why "
           "in include/mupm/kernels/fracture_flow.hpp.",
           crack_water_force_options().validator());
     f.set("Minimum Aperture", 1e-6,

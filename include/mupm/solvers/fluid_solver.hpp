@@ -197,6 +197,9 @@ class FluidSolver : public Module {
     b.stored = std::abs(e.stored);
     b.supplied_expression = "|E_s0| + |W_c| + |W_ext|";
     b.supplied = std::abs(e.stored0) + std::abs(e.coupling_work) + std::abs(e.external_work);
+    b.external_expression = "E_s0 + W_ext";
+    b.external = e.stored0 + e.external_work;
+    b.gross = std::abs(e.stored0) + std::abs(e.external_work);
     b.field = "pore_pressure";
     if (!fracture_)
       return {b};
@@ -207,11 +210,15 @@ class FluidSolver : public Module {
     f.expression = "E_f - E_f0 + W_sk + D_f - W_ext,f - W_x";
     f.error = std::abs(fe.balance());
     f.scale = fe.scale();
-    f.stored_expression = "|E_f - E_f0|";
-    f.stored = std::abs(fe.stored);
+    // A fall of its energy is energy it gave (E_f0 of an initial Fracture Pressure), not held.
+    f.stored_expression = "max(E_f - E_f0, 0)";
+    f.stored = std::max(fe.stored, 0.0);
     f.supplied_expression = "|W_ext,f| + |W_x| + |W_sk|";
     f.supplied =
         std::abs(fe.external_work) + std::abs(fe.exchange_work) + std::abs(fe.skeleton_work);
+    f.external_expression = "W_ext,f + W_x";
+    f.external = fe.external_work + fe.exchange_work;
+    f.gross = std::abs(fe.external_work) + std::abs(fe.exchange_work);
     f.field = "fracture_pressure";
     return {b, f};
   }

@@ -51,7 +51,16 @@ struct EnergyBalance {
   std::string stored_expression, supplied_expression;
   double stored = 0;    // energy held now [J]
   double supplied = 0;  // all the energy there was at the start and came in since [J]
+  // What came from outside the skeleton-water coupling [J]: the start, loads, sources,
+  // boundary layers, and the water exchanged between pores and crack (booked by the bulk at its
+  // pressure, by the crack at its own), signed; `gross` sums the same terms' magnitudes. The
+  // work exchanged between the solid and the waters (W_pore, W_c, W_sk) is not in them: it
+  // grows with a blow-up of the coupling itself (StepChecks::coupled in
+  // src/solvers/simulation.cpp).
+  std::string external_expression;
+  double external = 0, gross = 0;
   const char* field = "displacement";  // registry field whose largest value locates a blow-up
+  std::string hint;  // what may have made it diverge beyond the time step (for the message)
 };
 
 class Module {

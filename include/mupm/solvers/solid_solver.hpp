@@ -246,7 +246,15 @@ class SolidSolver : public Mechanics, public Skeleton {
     b.stored = std::abs(e.internal) + e.kinetic;
     b.supplied_expression = "|E_0| + |W_ext| + |W_pore|";
     b.supplied = std::abs(balance0_) + std::abs(e.external_work) + std::abs(e.pore_work);
+    b.external_expression = "E_0 + W_ext";
+    b.external = balance0_ + e.external_work;
+    b.gross = std::abs(balance0_) + std::abs(e.external_work);
     b.field = "displacement";
+    if (st_.P1f.extent(0) > 0)
+      b.hint =  // the blow-up's growth rate does not follow the step (inputs/README.md)
+          "Fracture->Crack Water Force = Eq 17 puts p_f on the bonds along the crack's faces, "
+          "whose work the crack water does not supply: it can blow up at any time step; use "
+          "Face Pressure.";
     return {b};
   }
 
