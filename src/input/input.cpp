@@ -522,7 +522,8 @@ RCP<ParameterList> valid_parameters() {
           "relaxation; 0: none.",
           at_least(0.0));
     s.set("Energy Tolerance", 1e-2,
-          "Largest accepted |E_int + E_kin + D - W_ext - W_pore - E_0| (solid, eqs 137-140) and "
+          "Largest accepted |E_int + E_kin - dt^2/8 sum m|a|^2 + D - W_ext - W_pore - E_0| "
+          "(solid, eqs 137-140, with the central difference's kinetic energy) and "
           "|E_s - E_s0 + W_c + D_f - W_ext,f| (fluid, eqs 147-149) relative to the largest of "
           "their terms; beyond it a warning with the step.",
           at_least(0.0));

@@ -923,6 +923,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   ph.damage->update_aperture();
   ph.initialize(time, restarted);
   const double dt = choose_time_step(run, ph, restarted, rank, out);
+  if (ph.mechanics)
+    ph.mechanics->set_time_step(dt);
   check_run_end(run, step, time, dt, restarted);
   if (rank == 0 && run.end_time > 0) {
     const long long last = expected_last_step(run, step, time, dt);

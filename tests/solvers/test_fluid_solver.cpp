@@ -106,10 +106,12 @@ TEST(FluidSolver, MassConservation) {
 }
 
 // The fluid energy balance (eqs 147-149 in power form): stored energy change + coupling work +
-// flow dissipation - external work stays a small fraction of the largest term on a stable
-// step (the forward-Euler error of the flow), and grows past it when the step exceeds the
-// stable one (1.1 x the estimate here): the check sees the instability before the pressure
-// overflows.
+// flow dissipation - external work, each booked at the pressure the step applies it at, is the
+// explicit scheme's energy identity: round-off on a stable step (0.5 x the estimate here), with
+// a positive dissipation. On an unstable one (1.1 x) the dissipation turns negative and the
+// stored energy outgrows everything supplied: the driver's divergence check
+// (src/solvers/simulation.cpp) stops the run while the state is still finite (at step 28 here,
+// where the unstable mode's points wet to saturation and their storage falls 1e4-fold).
 TEST(FluidSolver, EnergyBalanceFlagsInstability) {
   const double dx = 0.01;
   auto g = test::box<2>({16, 12}, 3.015, dx);
@@ -120,7 +122,8 @@ TEST(FluidSolver, EnergyBalanceFlagsInstability) {
   drain.kind = BoundaryCondition::PorePressure;
   drain.region_mask = 1u;
   drain.value = -9e3;  // close to the body's suction: k_r and C, and the stable step, stay put
-  double relative[2] = {0, 0};
+  double relative = 0;
+  int diverged[2] = {-1, -1};
   for (int k = 0; k < 2; ++k) {
     auto disc = discretize(test::world(), g);
     Kokkos::deep_copy(disc.points.porosity, 0.35);
@@ -131,85 +134,94 @@ TEST(FluidSolver, EnergyBalanceFlagsInstability) {
     FluidSolver<2> fluid(disc, prm, {drain}, MPI_COMM_WORLD);
     fluid.initialize(0, false);
     const double dt = (k == 0 ? 0.5 : 1.1) * fluid.estimate_stable_dt();
-    int flagged = -1;
-    for (int s = 0; s < 300 && flagged < 0; ++s) {
+    for (int s = 0; s < 300 && diverged[k] < 0; ++s) {
       fluid.advance(s * dt, dt, 1);
       const auto e = fluid.energy();
-      relative[k] = std::abs(e.balance()) / e.scale();
-      if (s >= 20 && !(relative[k] < 1e-2)) {  // checked after 20 steps, as the driver does
-        flagged = s;
-        // Still finite when flagged: the warning comes before the overflow.
-        EXPECT_TRUE(std::isfinite(e.stored)) << "step " << s;
+      if (k == 0)
+        relative = std::max(relative, std::abs(e.balance()) / e.scale());
+      // The driver's criteria (StepChecks), from step 2 on: the balance's stored energy 1000
+      // times its supply, or (the coupled check, one balance here) 1000 times the external
+      // supply and 10 times its terms' magnitudes.
+      const auto b = fluid.energy_balances().at(0);
+      if (s >= 1 && (b.stored > 1e3 * b.supplied ||
+                     (b.stored > 1e3 * b.external && b.stored > 10 * b.gross))) {
+        diverged[k] = s;
+        EXPECT_TRUE(std::isfinite(e.stored)) << "step " << s;  // before the overflow
       }
     }
     const auto e = fluid.energy();
     if (test::world()->getRank() == 0)
       std::printf(
           "[ fluid energy ] dt = %s stable step: E_s - E_s0 = %.4g J, D = %.4g J, W_ext = "
-          "%.4g J, |balance| / largest = %.3g (flagged at step %d)\n",
-          k == 0 ? "0.5" : "1.1", e.stored - e.stored0, e.dissipation, e.external_work, relative[k],
-          flagged);
+          "%.4g J, |balance| / largest = %.3g (diverged at step %d)\n",
+          k == 0 ? "0.5" : "1.1", e.stored - e.stored0, e.dissipation, e.external_work,
+          std::abs(e.balance()) / e.scale(), diverged[k]);
     if (k == 0) {
       EXPECT_GT(e.dissipation, 0.0);
     }
   }
-  EXPECT_LT(relative[0], 1e-2);
-  EXPECT_FALSE(relative[1] < 1e-2);
+  EXPECT_LT(relative, 1e-10);
+  EXPECT_EQ(diverged[0], -1);
+  EXPECT_GT(diverged[1], 0);
 }
 
 // A point source switched on at t = 0 in a body at rest, on a small step (1/25 of the stable
-// one): its pressure rises fastest in the first steps. The external work of the source is
-// booked with the pressure at which the stored energy takes the water in, so the balance error
-// is the flow's forward-Euler error and stays far inside the driver's 1 % from its first
-// checked step. (Measured: 1.1e-4 of the largest term; booked with the step's mean pressure
-// p + dp/2 it is 1.1e-2 here, as C varies over the step: false alarms.)
+// one), in unsaturated and in saturated water: its pressure rises fastest in the first steps.
+// Every term is booked at the pressure at which the stored energy takes the step's change in
+// (fluid_solver.hpp header), so the balance is the scheme's energy identity: round-off from
+// the first step on (the unsaturated one's from the stored energy's differences over small
+// steps). Measured: 8.6e-12 unsaturated and 6.4e-16 saturated of the largest term. With the
+// flow booked at the start pressure, as before, 1.3e-2 saturated at step 21 (false alarms).
 TEST(FluidSolver, PointSourceBalanceWithoutFalseAlarm) {
-  const double dx = 0.01;
-  auto g = test::box<2>({21, 21}, 3.015, dx);
-  g.region_names = {"well"};
-  g.regions = {box2(0.10, 0.11, 0.10, 0.11)};
-  auto disc = discretize(test::world(), g);
-  Kokkos::deep_copy(disc.points.porosity, 0.3);
-  set_pressure(disc.points, [](const double*) { return -20e3; });
-  auto prm = fluid_params(g, 1e-10, 0.5);
-  prm.retention = VanGenuchten::mualem(10e3, 2.0);
-  BoundaryCondition well;
-  well.name = "well";
-  well.kind = BoundaryCondition::FluidSource;
-  well.region_mask = 1u;
-  FluidSolver<2> probe(disc, prm, {}, MPI_COMM_WORLD);
-  probe.initialize(0, false);
-  const double dt = probe.estimate_stable_dt() / 25;
-  // About 2 % of the well point's pore volume per step: its suction falls by half in ~20 steps.
-  well.value = 0.02 * 0.3 * dx * dx / dt;
-  FluidSolver<2> fluid(disc, prm, {well}, MPI_COMM_WORLD);
-  fluid.initialize(0, false);
-  double worst = 0, p_well_start = 0, p_well_end = 0;
-  auto pressure_at_well = [&] {
-    auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.x);
-    auto pw = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.p);
-    double v = 0;
-    for (std::size_t i = 0; i < disc.points.n_owned; ++i)
-      if (std::abs(x(i, 0) - 0.105) < 1e-6 && std::abs(x(i, 1) - 0.105) < 1e-6)
-        v = pw(i);
-    MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-    return v;
-  };
-  p_well_start = pressure_at_well();
-  for (int s = 0; s < 100; ++s) {
-    fluid.advance(s * dt, dt, 1);
-    const auto e = fluid.energy();
-    if (s >= 20)
+  for (const bool saturated : {false, true}) {
+    const double dx = 0.01;
+    auto g = test::box<2>({21, 21}, 3.015, dx);
+    g.region_names = {"well"};
+    g.regions = {box2(0.10, 0.11, 0.10, 0.11)};
+    auto disc = discretize(test::world(), g);
+    Kokkos::deep_copy(disc.points.porosity, 0.3);
+    set_pressure(disc.points, [&](const double*) { return saturated ? 0.0 : -20e3; });
+    auto prm = fluid_params(g, 1e-10, 0.5);
+    if (!saturated)
+      prm.retention = VanGenuchten::mualem(10e3, 2.0);
+    BoundaryCondition well;
+    well.name = "well";
+    well.kind = BoundaryCondition::FluidSource;
+    well.region_mask = 1u;
+    FluidSolver<2> probe(disc, prm, {}, MPI_COMM_WORLD);
+    probe.initialize(0, false);
+    const double dt = probe.estimate_stable_dt() / 25;
+    // Unsaturated: about 2 % of the well point's pore volume per step (its suction falls by
+    // half in ~20 steps); saturated: 1 kPa per step at the well without flow.
+    well.value = (saturated ? 1e3 / prm.bulk_modulus : 0.02) * 0.3 * dx * dx / dt;
+    FluidSolver<2> fluid(disc, prm, {well}, MPI_COMM_WORLD);
+    fluid.initialize(0, false);
+    double worst = 0, p_well_start = 0, p_well_end = 0;
+    auto pressure_at_well = [&] {
+      auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.x);
+      auto pw = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.p);
+      double v = 0;
+      for (std::size_t i = 0; i < disc.points.n_owned; ++i)
+        if (std::abs(x(i, 0) - 0.105) < 1e-6 && std::abs(x(i, 1) - 0.105) < 1e-6)
+          v = pw(i);
+      MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+      return v;
+    };
+    p_well_start = pressure_at_well();
+    for (int s = 0; s < 100; ++s) {
+      fluid.advance(s * dt, dt, 1);
+      const auto e = fluid.energy();
       worst = std::max(worst, std::abs(e.balance()) / e.scale());
+    }
+    p_well_end = pressure_at_well();
+    if (test::world()->getRank() == 0)
+      std::printf(
+          "[ source ] %s: well pressure %.4g -> %.4g Pa; largest balance error / largest "
+          "term: %.2e\n",
+          saturated ? "saturated" : "unsaturated", p_well_start, p_well_end, worst);
+    EXPECT_GT(p_well_end - p_well_start, 5e3);  // the source does change the state
+    EXPECT_LT(worst, 1e-10);
   }
-  p_well_end = pressure_at_well();
-  if (test::world()->getRank() == 0)
-    std::printf(
-        "[ source ] well pressure %.4g -> %.4g Pa; largest balance error / largest term "
-        "after step 20: %.2e\n",
-        p_well_start, p_well_end, worst);
-  EXPECT_GT(p_well_end - p_well_start, 5e3);  // the source does change the state
-  EXPECT_LT(worst, 2e-3);
 }
 
 // A checkerboard pressure mode on a saturated body: with the flow stabilization its storage

@@ -22,20 +22,25 @@
 //
 // Energy (eqs 147-149, in power form): multiplying the mass balance by p gives
 //   d/dt sum V psi(p) = -sum V S_r p dV_s/dt - sum V p div + sum V p s + sum p supply,
-// psi the stored energy density (include/mupm/kernels/fluid.hpp). The update books the flow
-// dissipation D with the pressure at the start of each step (the rate forward Euler uses), and
-// the coupling work W_c (the water's work on the skeleton) with the step's mean pressure
-// p + dp/2 (the undrained response to a volume change is exact, not a forward-Euler rate), and
-// the external work W_ext (sources and reservoirs) with the pressure at which the stored energy
-// takes the water in, [psi(p + dp) - psi(p)] / (C dp) (p + dp/2 for constant C): the water a
-// source or a reservoir brings enters at the pressure it meets over the step. The balance
-// E_s(t) - E_s(0) + W_c + D - W_ext then differs from zero by the forward-Euler error of the
-// flow (sum V (p_e - p) dt div per step) and the storage's linearization over the volume
-// change: first order in dt for a smooth evolution, growing without bound when the step is
-// unstable. (Booking the sources with the start pressure, as before, made a point source's
-// first steps, where its pressure rises fastest, draw false alarms: 2.9 % of the largest term
-// at step 21 of a run at 1/25 of the stable step.) The driver checks the balance against
-// Solver->Energy Tolerance like the solid's (eq 149).
+// psi the stored energy density (include/mupm/kernels/fluid.hpp). A step changes a point's
+// content by C dp = -S_r dv + dt (s - div) (C and div at its start), and its stored energy by
+// psi(p + dp) - psi(p) = p_e C dp, with p_e = [psi(p + dp) - psi(p)] / (C dp) the pressure at
+// which the stored energy takes the change in (p + dp/2 for constant C). The update books the
+// coupling work W_c (the water's work on the skeleton), the external work W_ext (sources and
+// reservoirs) and the flow dissipation D each at p_e, the pressure the step applies them at:
+// the balance E_s(t) - E_s(0) + W_c + D - W_ext is then the scheme's own energy identity, zero
+// to round-off (and to the quadrature of psi) whenever the update and the booking agree: a
+// check of the kernels, the sources, the reservoirs and the coupling at every step. It is not
+// a check of forward Euler's accuracy: D is the energy the explicit step removes, dt
+// (p + dp/2) div, which differs from the continuous flow's by the step's first-order error
+// (the flow's own part dt^2 div^2 / (2 C), the cross terms with the sources' and the volume
+// change's increments). Booked with the start pressure, that error drew false alarms on
+// well-resolved runs (a point source switched on at once, saturated, at 1/25 of the stable
+// step: 1.3 % of the largest term at steps 21-29, and 2.3 % at every step with only the flow's
+// own part left; Example 3's fast van Genuchten storage changes up to 4.8 %). An unstable step
+// makes D negative in its growing modes and the stored energy grow beyond all supply: the
+// driver's divergence check stops it (src/solvers/simulation.cpp, StepChecks). The driver
+// checks the balance against Solver->Energy Tolerance like the solid's (eq 149).
 #ifndef MUPM_FLUID_SOLVER_HPP
 #define MUPM_FLUID_SOLVER_HPP
 
@@ -228,6 +233,7 @@ class FluidSolver : public Module {
   // and the volumetric-strain reference; computes S_r, k_r, C and the flow of the state.
   // A solid initialized afterwards computes tr(eps): then call reset_strain_reference().
   void initialize(double t, bool restarted) {
+    psi_valid_ = false;
     auto& p = disc_.points;
     auto regions = p.regions;
     auto fixed = p.fixed, vol = p.volume;
@@ -345,6 +351,7 @@ class FluidSolver : public Module {
     }
     skeleton.add_projection_work(r.work);
     projection_->flow_increment(dp_, hdp_);
+    psi_valid_ = false;
     auto pw = p.p, rate = p.p_rate, dp = dp_;
     Kokkos::parallel_for(
         "mupm::Fluid::projected_pressure", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
@@ -384,7 +391,8 @@ class FluidSolver : public Module {
           const bool held = fixed(i) & kFixedPressure;
           target(i) = held ? vol(i) * (C(i) * dp - rhs) : 0.0;  // the reservoir's water [m^3]
           const double pm = p0 + 0.5 * dp;
-          const double pe = entry_pressure(vg, phi(i), inv_kw, p0, dp, C(i), src(i) != 0 || held);
+          const double pe = src(i) != 0 || held ? entry_pressure(vg, phi(i), inv_kw, p0, dp, C(i))
+                                                : p0 + 0.5 * dp;
           wc += vol(i) * pm * sr(i) * dv;
           wd += vol(i) * pm * dt * flow;
           we += vol(i) * pe * dt * src(i) + pe * target(i);
@@ -417,17 +425,20 @@ class FluidSolver : public Module {
     return prm_.water_density * volume_integral(p.fluid_content, p.volume, p.n_owned, comm_);
   }
 
-  // sum_i V_i psi(p_i) [J].
+  // sum_i V_i psi(p_i) [J]; psi as the last explicit update left it where p has not changed
+  // since (the same values: one quadrature per point and step, not two).
   double stored_energy() const {
     const auto& p = disc_.points;
     auto pw = p.p, phi = p.porosity, vol = p.volume;
     const VanGenuchten vg = prm_.retention;
     const double inv_kw = 1.0 / prm_.bulk_modulus;
+    auto psi = psi_;
+    const bool cached = psi_valid_;
     double s = 0;
     Kokkos::parallel_reduce(
         "mupm::Fluid::stored_energy", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& acc) {
-          acc += vol(i) * stored_energy_density(vg, phi(i), inv_kw, pw(i));
+          acc += vol(i) * (cached ? psi(i) : stored_energy_density(vg, phi(i), inv_kw, pw(i)));
         },
         s);
     MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
@@ -723,6 +734,10 @@ class FluidSolver : public Module {
     // values follow their mirrors' new pressures: phase 1, after a ghost refresh.
     const Bytes mirrored = mirrored_;
     const bool any_mirrored = mirrored.extent(0) > 0;
+    if (psi_.extent(0) != p.n_owned)
+      psi_ = Scalars("mupm::stored_energy_density", p.n_owned);
+    auto psi = psi_;
+    const bool cached = psi_valid_;
     auto update = [&](const int phase) {
       double ws[3] = {0, 0, 0};
       Kokkos::parallel_reduce(
@@ -741,17 +756,22 @@ class FluidSolver : public Module {
               dp = C(i) > 0 ? rhs / C(i) : 0.0;  // eq 143
               target(i) = 0;
             }
-            const double pm = p0 + 0.5 * dp;  // the step's mean pressure
-            // Where water comes in or out (sources, reservoirs): the pressure at which the stored
-            // energy takes it (pm when C is constant).
-            const double pe = entry_pressure(vg, phi(i), inv_kw, p0, dp, C(i),
-                                             src(i) != 0 || (fixed(i) & kFixedPressure));
-            wc += vol(i) * pm * sr(i) * dv;
-            wd += vol(i) * p0 * dt * flow(i);
+            // The pressure at which the stored energy takes in the step's change of content:
+            // the step's mean pressure p0 + dp/2 when C is constant (header). psi(p0) is the
+            // last update's psi(p1) (psi_, which stored_energy() sums).
+            const double p1 = p0 + dp;
+            const double psi1 = stored_energy_density(vg, phi(i), inv_kw, p1);
+            const bool varies = storage_varies(vg, p0, p1);
+            const double psi0 =
+                varies ? (cached ? psi(i) : stored_energy_density(vg, phi(i), inv_kw, p0)) : 0.0;
+            psi(i) = psi1;
+            const double pe = entry_pressure(p0, dp, C(i), psi0, psi1, varies);
+            wc += vol(i) * pe * sr(i) * dv;
+            wd += vol(i) * pe * dt * flow(i);
             we += vol(i) * pe * dt * src(i) + pe * target(i);
             m(i) += C(i) * dp + sr(i) * dv;
             rate(i) = dp / dt;
-            pw(i) = p0 + dp;  // eq 145, beta_3 = 0
+            pw(i) = p1;  // eq 145, beta_3 = 0
           },
           ws[0], ws[1], ws[2]);
       for (int k = 0; k < 3; ++k)
@@ -763,6 +783,7 @@ class FluidSolver : public Module {
       set_pressure(t + dt, target, true);
       update(1);
     }
+    psi_valid_ = true;  // every owned point's psi(p), by phase 0 or 1
     book(target, w);
     evaluate();
   }
@@ -818,6 +839,10 @@ class FluidSolver : public Module {
   FluidState<Dim> st_;
   std::unique_ptr<FractureFlow<Dim>> fracture_;
   Scalars phat_, sink_;
+  // psi(p) of each owned point after the last explicit update, valid (psi_valid_) until
+  // anything else sets p: initialize(), the semi-implicit projection.
+  Scalars psi_;
+  bool psi_valid_ = false;
   double mass0_ = 0;  // water in the body at t = 0 [kg]
   Scalars source_, supply_;
   Bytes mirrored_;  // mark_mirrored()

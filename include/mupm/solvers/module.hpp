@@ -83,6 +83,8 @@ class Mechanics : public Module {
   // holds them) also the accelerations.
   virtual void initialize(double t, bool restarted) = 0;
   virtual void step(double t, double dt) = 0;
+  // The run's step, once chosen (after initialize): energies that depend on it.
+  virtual void set_time_step(double /*dt*/) {}
   // Whether the scheme has a stability limit, and the largest stable step (collective).
   virtual bool limits_time_step() const { return false; }
   virtual double stable_time_step() { return 0.0; }
