@@ -467,8 +467,9 @@ RCP<ParameterList> valid_parameters() {
           "Equal fluid steps per fluid interval (sub-cycling when flow is faster than the "
           "solid); 0: as many as Time Step Safety Factor x the estimated stable fluid step "
           "requires. With Physics = Pore Fluid the interval is Time Step (Automatic Time Step "
-          "sets it to the safety factor x the stable fluid step).",
-          at_least(0));
+          "sets it to the safety factor x the stable fluid step). At most 1e6, the automatic "
+          "choice's limit too (2147483647 ran for ever).",
+          rcp(new Teuchos::EnhancedNumberValidator<int>(0, 1000000)));
     s.set("Pressure Integration", std::string("Explicit"),
           "Hydro-Mechanical: how the pore pressure is advanced. Explicit: forward Euler in p "
           "with the undrained split (the pore water's stiffness K_w/phi in the solid's stable "

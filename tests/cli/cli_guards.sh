@@ -34,6 +34,9 @@ base '' '<Parameter name="End Time" type="double" value="1e308"/>' >end_time_max
 expect end_time_max 2 'mupm->Solver->End Time = 1e+308 s'
 base '' '<Parameter name="End Time" type="double" value="1e13"/><Parameter name="Automatic Time Step" type="bool" value="true"/>' >end_time_auto.xml
 expect end_time_auto 2 'mupm->Solver->End Time = 1e+13 s' "Automatic Time Step's estimate"
+# Fluid Substeps beyond the automatic choice's limit (2147483647 ran for ever).
+base '' '<Parameter name="Fluid Substeps" type="int" value="2147483647"/>' >substeps_huge.xml
+expect substeps_huge 2 'mupm->Solver->Fluid Substeps = 2147483647 is not valid' 'At most 1e6'
 # An Output->Folder below a regular file: said so (it was "not writable (Permission denied)").
 touch afile
 base '' '' | sed 's|value="out"|value="afile/sub"|' >folder_below_file.xml
