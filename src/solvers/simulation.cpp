@@ -383,6 +383,12 @@ void initial_state(const Model<Dim>& model, Points<Dim>& pts) {
   apply_initial_conditions(model.initial_conditions, pts, rho_w_g);
 }
 
+std::string shortest(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 // The most fluid substeps per fluid interval a run may take (each costs about a solid step).
 constexpr double kMaxFluidSubsteps = 1e6;
 
@@ -501,6 +507,17 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
   if (solid) {
     const double stiffening = ph.fluid ? ph.fluid->undrained_stiffening() : 0.0;
     const double stable = three_digits(solid->stable_time_step());
+    // Constants far outside their physical range (a modulus of 1e300 Pa, a density of
+    // 1e-300 kg/m^3) leave no step to choose: say so, rather than let a zero step reach the
+    // fluid's substep count (it read "would need -0 substeps").
+    if (run.automatic_time_step && !kept && !(stable > 0 && std::isfinite(stable)))
+      throw InputError(
+          "Error, the solid's estimated stable step is " + shortest(stable) +
+          " s: Solver->Automatic Time Step has no step to choose. It is 2 / omega_max of the "
+          "discrete operator, from mupm->Materials (Bulk Modulus, Shear Modulus, Micropolar "
+          "Shear Modulus, Length Scale, Solid Density, Porosity), the fluid's undrained "
+          "stiffening and mupm->Discretization (Spacing, Thickness): check them for values "
+          "beyond their physical range.");
     if (kept)
       dt = ph.watch.time_step;
     else if (run.automatic_time_step)
@@ -533,6 +550,14 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
   if (ph.fluid && !ph.fluid->semi_implicit()) {
     auto& fluid = *ph.fluid;
     const double stable_f = three_digits(fluid.estimate_stable_dt());
+    if (!(stable_f > 0 && std::isfinite(stable_f)) && (run.fluid_substeps == 0 || !solid))
+      throw InputError(
+          "Error, the pore fluid's estimated stable step is " + shortest(stable_f) +
+          " s: no fluid step can be chosen. It is about dx^2 C / (k/mu_w), from "
+          "mupm->Fluid (Hydraulic Conductivity or Intrinsic Permeability / Viscosity, Water "
+          "Density, Fluid Bulk Modulus, the retention curve), mupm->Materials->Porosity and "
+          "mupm->Discretization (Spacing, Thickness): check them for values beyond their "
+          "physical range.");
     if (!solid && run.automatic_time_step)
       dt = kept ? ph.watch.time_step : safety * stable_f;
     const int every = ph.sequence.fluid_every;

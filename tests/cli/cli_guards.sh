@@ -37,6 +37,13 @@ expect end_time_auto 2 'mupm->Solver->End Time = 1e+13 s' "Automatic Time Step's
 # Fluid Substeps beyond the automatic choice's limit (2147483647 ran for ever).
 base '' '<Parameter name="Fluid Substeps" type="int" value="2147483647"/>' >substeps_huge.xml
 expect substeps_huge 2 'mupm->Solver->Fluid Substeps = 2147483647 is not valid' 'At most 1e6'
+# A modulus beyond its physical range leaves Automatic Time Step no step: said so (it read
+# "the pore fluid's estimated stable step is 1.57e-05 s: a fluid interval of 0 s would need -0
+# substeps").
+base '' '<Parameter name="Automatic Time Step" type="bool" value="true"/>' |
+  sed 's|name="Bulk Modulus" type="double" value="1e8"|name="Bulk Modulus" type="double" value="1e300"|' >modulus_huge.xml
+grep -q 'value="1e300"' modulus_huge.xml || fail "modulus_huge.xml not derived"
+expect modulus_huge 2 "the solid's estimated stable step is 0 s" 'Bulk Modulus'
 # An Output->Folder below a regular file: said so (it was "not writable (Permission denied)").
 touch afile
 base '' '' | sed 's|value="out"|value="afile/sub"|' >folder_below_file.xml
