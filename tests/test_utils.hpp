@@ -29,6 +29,16 @@ GridSpec<Dim> box(std::array<long long, Dim> counts, double factor, double dx = 
   return g;
 }
 
+// A 2D region [x0, x1] x [y0, y1].
+inline Box box2(double x0, double x1, double y0, double y1) {
+  Box b;
+  b.lo[0] = x0;
+  b.hi[0] = x1;
+  b.lo[1] = y0;
+  b.hi[1] = y1;
+  return b;
+}
+
 // Lattice position of a global id (the tests' own version of the grid's numbering).
 template <int Dim>
 std::array<double, Dim> position(const GridSpec<Dim>& g, GlobalId gid) {

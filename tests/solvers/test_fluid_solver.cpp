@@ -37,14 +37,7 @@ void set_pressure(Points<2>& p, std::function<double(const double*)> f) {
   Kokkos::deep_copy(p.p, pw);
 }
 
-Box box2(double x0, double x1, double y0, double y1) {
-  Box b;
-  b.lo[0] = x0;
-  b.hi[0] = x1;
-  b.lo[1] = y0;
-  b.hi[1] = y1;
-  return b;
-}
+using test::box2;
 
 // Water mass with impervious boundaries is constant to round-off; a source adds exactly the
 // injected mass; a drained boundary's reported inflow is exactly the mass change.

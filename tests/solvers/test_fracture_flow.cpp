@@ -793,12 +793,8 @@ TEST(FractureFlowSemiImplicit, CrackWaterBalanceHoldsThroughBreakage) {
   c.b[0] = 0.4 * L;
   c.b[1] = 0.5 * H;
   g.cracks = {c};
-  Box mouth;
-  mouth.lo[0] = mouth.lo[1] = -1;
-  mouth.hi[0] = 2 * dx;
-  mouth.hi[1] = 1;
   g.region_names = {"mouth"};
-  g.regions = {mouth};
+  g.regions = {test::box2(-1, 2 * dx, -1, 1)};
   Discretization<2> disc = discretize(test::world(), g);
   auto& p = disc.points;
   const auto law = MicropolarElastic::from_bulk_shear(270.83e6, 220.33e6, 100e6, 1e-3);

@@ -500,6 +500,17 @@ TEST(SolidSolver, SlavedVelocityLayerMovesAsDisplacement) {
   EXPECT_LT(by_velocity.balance_error, 1e-3 * by_velocity.work);
 }
 
+// Displacements held at 0 along x and y on the regions of `mask` (0: every point).
+std::vector<BoundaryCondition> held(std::uint32_t mask) {
+  BoundaryCondition hold_x, hold_y;
+  hold_x.kind = hold_y.kind = BoundaryCondition::Displacement;
+  hold_x.name = "hx";
+  hold_y.name = "hy";
+  hold_x.region_mask = hold_y.region_mask = mask;
+  hold_y.component = 1;
+  return {hold_x, hold_y};
+}
+
 // A uniform body couple m on a body whose displacements are held: at rest the Cosserat
 // coupling balances it, -4 mu_c theta + m = 0 (from sigma_xy - sigma_yx = 4 mu_c theta, eq 80),
 // so theta = m / (4 mu_c) (uniform: no couple stress, and free faces need d theta/dn = 0).
@@ -510,17 +521,15 @@ TEST(SolidSolverLong, BodyCoupleAgainstCosseratCoupling) {
   auto g = test::box<2>({40, 40}, 3.015, dx);
   auto disc = discretize(test::world(), g);
   Kokkos::deep_copy(disc.points.saturation, 1.0);
-  BoundaryCondition hold_x, hold_y, couple;
-  hold_x.kind = hold_y.kind = BoundaryCondition::Displacement;
-  hold_x.name = "hx";
-  hold_y.name = "hy";
-  hold_y.component = 1;
+  BoundaryCondition couple;
   couple.kind = BoundaryCondition::BodyCouple;
   couple.name = "m";
   couple.value = 4e4;  // N m / m^3
   typename SolidSolver<2>::Settings set;
   set.damping = 5e4;  // near critical for the rotation: omega = sqrt(4 mu_c / J) = 4.7e4 /s
-  SolidSolver<2> solver(disc, params(kLaw, g), {hold_x, hold_y, couple}, set, MPI_COMM_WORLD);
+  auto bcs = held(0);
+  bcs.push_back(couple);
+  SolidSolver<2> solver(disc, params(kLaw, g), bcs, set, MPI_COMM_WORLD);
   solver.initialize(0.0, false);
   const double dt = 0.5 * solver.estimate_stable_dt();
   double time = 0;
@@ -552,25 +561,18 @@ TEST(SolidSolverLong, BodyCoupleAgainstCosseratCoupling) {
 TEST(SolidSolver, SuddenLoadBalanceClosesWithTheCentralDifferenceEnergy) {
   const double dx = 2.5e-3;
   auto g = test::box<2>({12, 10}, 3.015, dx);
-  Box left;
-  left.lo[0] = left.lo[1] = -1;
-  left.hi[0] = 1.5 * dx;
-  left.hi[1] = 1;
   g.region_names = {"left"};
-  g.regions = {left};
+  g.regions = {test::box2(-1, 1.5 * dx, -1, 1)};
   auto disc = discretize(test::world(), g);
   Kokkos::deep_copy(disc.points.saturation, 1.0);
-  BoundaryCondition hold_x, hold_y, push;
-  hold_x.kind = hold_y.kind = BoundaryCondition::Displacement;
-  hold_x.name = "hx";
-  hold_y.name = "hy";
-  hold_x.region_mask = hold_y.region_mask = 1u;
-  hold_y.component = 1;
+  BoundaryCondition push;
   push.kind = BoundaryCondition::BodyForce;
   push.name = "push";
   push.value = 1e6;  // N/m^3 along x, from t = 0
   typename SolidSolver<2>::Settings set;
-  SolidSolver<2> solver(disc, params(kLaw, g), {hold_x, hold_y, push}, set, MPI_COMM_WORLD);
+  auto bcs = held(1u);
+  bcs.push_back(push);
+  SolidSolver<2> solver(disc, params(kLaw, g), bcs, set, MPI_COMM_WORLD);
   solver.initialize(0.0, false);
   const double dt = 0.9 * solver.estimate_stable_dt();
   solver.set_time_step(dt);
