@@ -80,7 +80,7 @@ cube() {  # cube FOLDER N HORIZON STEPS
 XML
 }
 
-# it/step: GMRES iterations; solve ms: the projection per step without its assembly (once per
+# it/step: Krylov iterations (CG, or GMRES with mirrored pressure layers); solve ms: the projection per step without its assembly (once per
 # run here: no bond breaks); rest ms: the rest of the step (solid, fluid, output); share: the
 # projection's part of the step without the assembly.
 printf '%-9s %5s %8s %5s %7s %9s %9s %10s %6s\n' case ranks points steps "it/step" "solve ms" "rest ms" "assemble s" share

@@ -493,15 +493,15 @@ RCP<ParameterList> valid_parameters() {
     {
       ParameterList& ps = s.sublist(
           "Pressure Solve", false,
-          "The linear solve of Pressure Integration = Semi-Implicit (Trilinos: Belos' GMRES, "
-          "Ifpack2), "
+          "The linear solve of Pressure Integration = Semi-Implicit (Trilinos: Belos' CG, or "
+          "GMRES where mirrored pressure layers make the system unsymmetric; Ifpack2), "
           "distributed over the ranks like the points.");
       ps.set("Preconditioner", std::string("ILU"),
-             "Ifpack2's preconditioner: ILU (RILUK on each rank's rows; a breakdown, a zero "
-             "pivot, falls back to Jacobi for that matrix), Jacobi or None.",
+             "Ifpack2's preconditioner: ILU (RILUK on each rank's rows; a solve that fails with "
+             "it, e.g. at a zero pivot, is repeated with Jacobi for that matrix), Jacobi or None.",
              one_of({"ILU", "Jacobi", "None"}));
       ps.set("ILU Fill Level", 0, "Level of fill k of ILU(k).", at_least(0));
-      ps.set("Tolerance", 1e-10,
+      ps.set("Tolerance", 1e-11,
              "Residual ||b - A x|| at which the solve stops, relative to the largest right-hand "
              "side ||b|| of the run so far (the water balances of a step): every point's water "
              "balance holds to it (the CSV's fluid_mass_error accumulates it).",

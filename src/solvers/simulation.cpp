@@ -544,8 +544,8 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
         << " m^2/(Pa s), K_w = " << f.bulk_modulus
         << " Pa, flow stabilization G = " << f.stabilization
         << ", pressure stabilization G_p = " << f.projection_stabilization
-        << "; one solve per step ("
-        << "GMRES, " << ls.preconditioner << ", tolerance " << ls.tolerance << ")\n";
+        << "; one solve per step (" << ph.fluid->pressure_solve_method() << ", "
+        << ls.preconditioner << ", tolerance " << ls.tolerance << ")\n";
   }
   if (ph.fluid && !ph.fluid->semi_implicit()) {
     auto& fluid = *ph.fluid;

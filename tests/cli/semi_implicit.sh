@@ -50,7 +50,7 @@ with h5py.File("straight/" + f) as a, h5py.File("threads/" + f) as b:
         diff = np.abs(x - y).max() / scale
         print("2 ranks x 1 thread vs 1 rank x 2 threads: %s differs by %.2e of its largest value"
               % (field, diff))
-        assert scale > 0 and diff < 1e-8, field
+        assert scale > 0 and diff < 1e-10, field
 rows = list(csv.DictReader(open("straight/time_series.csv")))
 last = rows[-1]
 mass, error = float(last["fluid_mass"]), float(last["fluid_mass_error"])
@@ -100,7 +100,7 @@ with h5py.File("ff_straight/checkpoint.h5") as a, h5py.File("ff_threads/checkpoi
         scale = np.abs(x).max()
         diff = np.abs(x - y).max() / scale
         print("fracture flow, 2 ranks x 1 thread vs 1 rank x 2 threads: %s differs by %.2e of its largest value" % (field, diff))
-        assert scale > 0 and diff < 1e-8, field
+        assert scale > 0 and diff < 1e-10, field
 rows = list(csv.DictReader(open("ff_straight/time_series.csv")))
 last = rows[-1]
 water = float(last["fluid_mass"]) + float(last["fracture_fluid_mass"])

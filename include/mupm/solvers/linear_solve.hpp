@@ -1,8 +1,8 @@
 // A distributed sparse linear solve on Trilinos' stack: a Tpetra CrsMatrix over the points' map
-// (or the fracture network's), Belos' GMRES and an Ifpack2 preconditioner (ILU(k) by default,
-// or Jacobi), built once per matrix and reused for every
-// right-hand side until the matrix changes (set_matrix). No rank ever holds more than its own
-// rows.
+// (or the fracture network's), Belos' GMRES (or CG for a symmetric positive definite matrix) and
+// an Ifpack2 preconditioner (ILU(k) by default, or Jacobi), built once per matrix and reused for
+// every right-hand side until the matrix changes (set_matrix; refresh when only its values do).
+// No rank ever holds more than its own rows.
 //
 // Results across rank counts: the Krylov iterates depend on the order of the reductions and on
 // the preconditioner's subdomains (Ifpack2 builds ILU per rank, additive Schwarz without
@@ -24,11 +24,16 @@ using CrsMatrix = Tpetra::CrsMatrix<double, LocalId, GlobalId>;
 using TpetraVector = Tpetra::Vector<double, LocalId, GlobalId>;
 
 struct LinearSolveSettings {
+  // "GMRES" | "CG": CG needs a symmetric positive definite matrix and preconditioner (ILU(k) of
+  // a symmetric matrix is L D L^T up to round-off); it keeps no basis, so an iteration costs a
+  // product, a preconditioner apply and three reductions, GMRES's also an orthogonalization
+  // against every earlier vector.
+  std::string method = "GMRES";
   std::string preconditioner = "ILU";  // "ILU" (Ifpack2 RILUK) | "Jacobi" | "None"
   int fill_level = 0;                  // ILU(k)
-  double tolerance = 1e-10;            // ||b - A x|| / the largest ||b|| so far
+  double tolerance = 1e-11;            // ||b - A x|| / the largest ||b|| so far
   int max_iterations = 1000;
-  int restart = 100;  // GMRES restart length
+  int restart = 100;  // GMRES restart length (not used by CG)
 };
 
 struct LinearSolveResult {
@@ -44,15 +49,20 @@ class LinearSolve {
   LinearSolve(const LinearSolve&) = delete;
   LinearSolve& operator=(const LinearSolve&) = delete;
 
-  // A new matrix (or new values): the preconditioner is computed again.
+  // A new matrix: the preconditioner is set up again (symbolic and numeric parts).
   void set_matrix(const Teuchos::RCP<const CrsMatrix>& a);
+  // The matrix of the last set_matrix has new values on the same graph: the preconditioner's
+  // numeric part again (an ILU's factors; its symbolic part is kept). The same factors as
+  // set_matrix would give: a restart that calls set_matrix instead reproduces the run. Collective.
+  void refresh();
   // Solves A x = b (x: the initial guess on entry) to the tolerance times `scale`, the largest
   // ||b|| so far (updated here; a caller that restarts keeps it). Collective.
   LinearSolveResult solve(const TpetraVector& b, TpetraVector& x, double& scale);
   const LinearSolveSettings& settings() const { return set_; }
   // Preconditioner set-ups since construction (for the benchmarks).
   long long setups() const { return setups_; }
-  // ILU breakdowns since construction, each answered with Jacobi for that matrix (solve()).
+  // ILU breakdowns since construction, each answered with Jacobi for that matrix (solve(); kept
+  // by refresh until the next set_matrix).
   long long fallbacks() const { return fallbacks_; }
 
  private:

@@ -38,7 +38,7 @@
 // constraint removes modes, it adds no faster ones: the drained CFL bound holds); with C > 0
 // the water is a stiffness taken implicitly (backward Euler in p, unconditionally stable for
 // the flow's and the storage's symmetric positive parts), and the projection term damps the
-// pressure's impulse at first order (the projection work below is negative). This is the
+// pressure's impulse at first order. This is the
 // argument, not a proof for the nonlocal operators; measured: stable at 0.5 of the drained
 // estimate in every test (tests/solvers/test_fluid_solver.cpp, FluidSolverSemiImplicit and
 // FluidSolverLong.TerzaghiSemiImplicit*, tests/cli/semi_implicit.sh). Without the pressure
@@ -51,13 +51,23 @@
 // the bookkeeping (FluidSolver::finish_projection) adds C dp + S_r d(tr eps) to the water
 // content with the skeleton's actual volume change and the linearized flow div(p_n) + H dp,
 // whose volume integral is zero (H 1 = 0), so the CSV's water mass error is the accumulated
-// residual of the solves. Energy: the step is velocity Verlet with the start-of-step force
-// F_n + 2 B~^T dp (v* + dt a_dp = v_n + dt/2 M^-1 (F_n + 2 B~^T dp)), so the solid's ledger
-// books, besides the trapezoid of the pore water's force (p_n + p_{n+1})/2 over the step,
-// the correction's work (B~^T dp) . (u_{n+1} - u_n) on the free components: the projection
-// work, negative where the pressure resists the volume change (what the projection
-// dissipates, reported as projection_work). The fluid's balance books the same trapezoid as
-// its coupling work.
+// residual of the solves. Energy: the solid's ledger is the central difference's
+// L_n = E_int(u_n) + 1/2 m |v_n|^2 - dt^2/8 m |a_n|^2 (solid_solver.hpp, Energy::kinetic_shift),
+// a_n from the forces at t_n with p_n. In leapfrog form the impulse over the step centred at
+// t_n is dt (F_n + B~^T p_{n+1}) (above), and for a linear skeleton
+//   1/2 m |v_{n+1/2}|^2 - 1/2 m |v_{n-1/2}|^2 = (F_n + B~^T p_{n+1}) . (u_{n+1} - u_{n-1}) / 2
+// together with L_n = 1/2 m |v_{n-1/2}|^2 + 1/2 u_{n-1} . K u_n + 1/2 (u_n - u_{n-1}) . G_n
+// (G_n the pressure's and the external force at t_n; v_n = v_{n-1/2} + dt/2 a_n) give exactly
+//   L_{n+1} - L_n = 1/2 (u_{n+1} - u_n) . (G_n + G_{n+1}) + B~^T dp . (u_{n+1} - u_{n-1}) / 2:
+// the trapezoid of the pore water's force (p_n + p_{n+1})/2 over the step, which the fluid's
+// balance books as its coupling work too, and the correction's work over the centred interval,
+// booked on the free components as projection_work, with u_n - u_{n-1} = dt v_{n-1/2} =
+// dt (v* - dt a_n) (at a start from rest the leapfrog's v_{-1/2} = -dt/2 a_0). The balance
+// closes to round-off from the first step (tests/solvers/test_fluid_solver.cpp,
+// FluidSolverSemiImplicit.ImpulsiveStartBalanceCloses; booking (u_{n+1} - u_n) instead left a
+// constant O(dt^2) offset at an impulsive start, 4 % of the early largest term on Example 1 case
+// 1). The projection work is what the correction's pressure does on the skeleton beyond the
+// trapezoid; it is part of pore_pressure_work, not a dissipation of fixed sign.
 //
 // Pressure stabilization (Solver->Pressure Stabilization, G_p). On a regular grid the
 // checkerboard p_i = (-1)^(i_x) (and its y, z and diagonal kin) has a zero nonlocal gradient at
@@ -101,7 +111,7 @@
 //   [ sym.      V C_f + dt L + dt V G + dt^2 B_f M^-1 B_f^T ] [dpf] = [ r_f ],
 // L the network's cubic-law Laplacian, r_f = -S_rf A (c* - c_ref) + dt (L-flow, exchange at
 // p^n, p_f^n) + dt Q with c* the opening at the skeleton's prediction u*: symmetric positive
-// semi-definite as the bulk's (each added term is), so GMRES with ILU(0) solves it as before.
+// semi-definite as the bulk's (each added term is), so it is solved as the bulk's is.
 // Why this removes the K_w / a_min limit: the explicit scheme applies p_f through the undrained
 // spring M_f = K_w / (c + a_min) between the faces (kernels/fracture_flow.hpp), a stiffness in
 // the explicit step; here the faces see p_f^{n+1} of the implicit balance, so the crack water
@@ -115,27 +125,30 @@
 // water's energy balance closes as in the explicit scheme (its skeleton work is booked with the
 // opening the correction reached, over the bonds the solve used; the jump of a point's mean
 // opening when its bonds break enters the next step's balance); the correction's work on the
-// faces (B_f^T dpf . du) is part of projection_work. The network's rows change every step
-// (apertures set Lambda), so with a network the system and its ILU are composed every step (the
-// bulk's part is kept); the joint map changes when points join, or B_f when bonds break: then
-// everything is assembled again. Measured (tests/solvers/test_fracture_flow.cpp,
-// FractureFlowSemiImplicit): incompressible water injected into a free slot opens it by the
-// injected volume to 1e-10 at the drained step; against the explicit scheme on Example 1 case 1 at
-// 66 x 66 (K_w = 2.2 GPa, a_min = 0.1 mm, the first 20 us): the semi-implicit run at 0.3 and 0.05
-// us gives the same external work to 0.1 % (2.217e-6, 2.216e-6 J; 1.95e-6 J at its automatic
-// step, 6.65 us, three steps); the explicit one 1.706e-6, 2.094e-6 and 2.236e-6 J at 0.05, 0.01 and
-// 0.002 us, first order in dt towards it (the explicit crack force lags by a step,
-// fracture_flow.hpp).
+// faces is part of projection_work. The network's rows change every step (apertures set
+// Lambda): with a network their values are added to the kept rest in place on a kept graph, and
+// the preconditioner's numeric part is computed again (compose); the joint map changes when
+// points join, or B_f when bonds break: then everything is assembled again. Measured
+// (tests/solvers/test_fracture_flow.cpp, FractureFlowSemiImplicit): incompressible water injected
+// into a free slot opens it by the injected volume to 1e-10 at the drained step; against the
+// explicit scheme on Example 1 case 1 at 66 x 66 (K_w = 2.2 GPa, a_min = 0.1 mm, the first 20 us):
+// the semi-implicit run at 0.3 and 0.05 us gives the same external work to 0.1 %
+// (2.217e-6, 2.216e-6 J; 1.95e-6 J at its automatic step, 6.65 us, three steps); the explicit
+// one 1.706e-6, 2.094e-6 and 2.236e-6 J at 0.05, 0.01 and 0.002 us, first order in dt towards it
+// (the explicit crack force lags by a step, fracture_flow.hpp).
 //
 // The matrix and its preconditioner are kept while the bonds, the time step, the saturation,
 // the relative permeability and the densities are unchanged (a saturated run without breakage
-// assembles once).
+// assembles once). The solve is CG where A is symmetric (no image points; krylov below),
+// GMRES otherwise, each with ILU(k) (include/mupm/solvers/linear_solve.hpp).
 #ifndef MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 #define MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 
 #include <mpi.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "mupm/solvers/module.hpp"
@@ -157,7 +170,7 @@ class PressureProjection {
   PressureProjection(Discretization<Dim>& disc, const LinearSolveSettings& settings,
                      std::vector<PressureRole> roles, std::vector<LocalId> images, MPI_Comm comm)
       : disc_(disc),
-        solver_(settings),
+        solver_(krylov(settings, roles, comm)),
         roles_(std::move(roles)),
         images_(std::move(images)),
         comm_(comm) {
@@ -167,6 +180,7 @@ class PressureProjection {
   // The fracture pressures' gid offset in the joint numbering (CrackBlock).
   GlobalId crack_offset() const { return offset_; }
 
+  const std::string& method() const { return solver_.settings().method; }
   // The bonds changed: assemble again before the next solve.
   void invalidate() { stale_ = true; }
   long long assemblies() const { return assemblies_; }
@@ -193,13 +207,12 @@ class PressureProjection {
     if (needs_assembly(dt, st, sk, crack))
       assemble(dt, prm, st, sk, crack);
     Teuchos::RCP<CrsMatrix> network;
-    if (any_crack_) {  // the network's rows change every step (apertures): a new matrix
+    if (any_crack_) {  // the network's rows change every step (apertures): new values
       network = network_rows(crack);
       auto ns = Teuchos::rcp(new CrsMatrix(joint_, 0));
       Tpetra::MatrixMatrix::Multiply(*network, false, *images_matrix_, false, *ns);
       ns->leftScale(*keep_);
-      system_ = Tpetra::MatrixMatrix::add(1.0, false, *composed_, 1.0, false, *ns);
-      solver_.set_matrix(system_);
+      compose(*ns);
     } else if (system_ != composed_) {
       system_ = composed_;
       solver_.set_matrix(system_);
@@ -294,9 +307,12 @@ class PressureProjection {
             continue;
           double& pos = k < Dim ? p.u(i, k) : p.theta(i, k - Dim);
           double& vel = k < Dim ? p.v(i, k) : p.omega(i, k - Dim);
+          // u_n - u_(n-1) = dt v_(n-1/2) = dt (v* - dt a_n) (header: the projection work)
+          const double acc = k < Dim ? p.a(i, k) : p.alpha(i, k - Dim);
+          const double before = dt * (vel - dt * acc);
           pos += dt * dt * a;
           vel += dt * a;
-          work += fv(q, 0) * (pos - sk.start(i, k));
+          work += 0.5 * fv(q, 0) * (pos - sk.start(i, k) + before);
         }
       }
     }
@@ -341,6 +357,74 @@ class PressureProjection {
     MPI_Allreduce(MPI_IN_PLACE, flags, 2, MPI_INT, MPI_MAX, comm_);
     any_crack_ = flags[1] != 0;
     return changed != 0;
+  }
+
+  // CG where the system is symmetric: without image points (S_H = S_P = R in assemble, and the
+  // network's rows are symmetric: Lambda_ij = Lambda_ji, the exchange on both sides); GMRES
+  // with images (an image's row and column differ). The same choice on every rank.
+  static LinearSolveSettings krylov(LinearSolveSettings s, const std::vector<PressureRole>& roles,
+                                    MPI_Comm comm) {
+    int images = 0;
+    for (const PressureRole r : roles)
+      images |= r == PressureRole::OddImage || r == PressureRole::EvenImage;
+    MPI_Allreduce(MPI_IN_PLACE, &images, 1, MPI_INT, MPI_MAX, comm);
+    s.method = images ? "GMRES" : "CG";
+    return s;
+  }
+
+  // system_ = composed_ + ns (ns the network's rows of the step, R N S_H) on a graph kept while
+  // ns's pattern and composed_ do not change: the values are written in place (composed_'s,
+  // then ns's added: the same sums on every step, whether the graph is new or kept, so a
+  // restart, which builds it again, gives the same matrix) and the preconditioner's numeric
+  // part alone is computed again (LinearSolve::refresh).
+  void compose(const CrsMatrix& ns) {
+    ScopedRegion region("mupm::Pressure::compose");
+    const auto nl = ns.getLocalMatrixHost();
+    const auto& ncols = *ns.getColMap();
+    std::vector<GlobalId> pattern;  // (row, column) gids of ns's entries, in its storage order
+    pattern.reserve(2 * nl.values.extent(0));
+    for (LocalId r = 0; r < LocalId(nl.numRows()); ++r)
+      for (auto q = nl.graph.row_map(r); q < nl.graph.row_map(r + 1); ++q) {
+        pattern.push_back(joint_->getGlobalElement(r));
+        pattern.push_back(ncols.getGlobalElement(nl.graph.entries(q)));
+      }
+    int rebuild = system_.is_null() || system_ == composed_ || pattern != pattern_ ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &rebuild, 1, MPI_INT, MPI_MAX, comm_);
+    if (rebuild) {
+      system_ = Tpetra::MatrixMatrix::add(1.0, false, *composed_, 1.0, false, ns);
+      if (!system_->getRowMap()->isSameAs(*joint_) || !composed_->getRowMap()->isSameAs(*joint_))
+        throw std::logic_error("PressureProjection::compose: the rows are not the joint map's");
+      const auto sl = system_->getLocalMatrixHost();
+      const auto& scols = *system_->getColMap();
+      // The position in system_ of row r's entry at global column g.
+      auto at = [&](LocalId r, GlobalId g) {
+        for (auto q = sl.graph.row_map(r); q < sl.graph.row_map(r + 1); ++q)
+          if (scols.getGlobalElement(sl.graph.entries(q)) == g)
+            return std::size_t(q);
+        throw std::logic_error("PressureProjection::compose: an entry is not in the sum's graph");
+      };
+      base_.assign(sl.values.extent(0), 0.0);
+      const auto cl = composed_->getLocalMatrixHost();
+      const auto& ccols = *composed_->getColMap();
+      for (LocalId r = 0; r < LocalId(cl.numRows()); ++r)
+        for (auto q = cl.graph.row_map(r); q < cl.graph.row_map(r + 1); ++q)
+          base_[at(r, ccols.getGlobalElement(cl.graph.entries(q)))] = cl.values(q);
+      where_.resize(nl.values.extent(0));
+      for (std::size_t q = 0; q < where_.size(); ++q)
+        where_[q] = at(joint_->getLocalElement(pattern[2 * q]), pattern[2 * q + 1]);
+      pattern_ = std::move(pattern);
+    }
+    {
+      const auto v = system_->getLocalValuesView();
+      for (std::size_t q = 0; q < base_.size(); ++q)
+        v(q) = base_[q];
+      for (std::size_t q = 0; q < where_.size(); ++q)
+        v(where_[q]) += nl.values(q);
+    }
+    if (rebuild)
+      solver_.set_matrix(system_);
+    else
+      solver_.refresh();
   }
 
   // The network's rows of the step (CrackBlock, header): storage, flow and exchange on the
@@ -519,6 +603,10 @@ class PressureProjection {
       composed_, system_;
   Teuchos::RCP<TpetraVector> inverse_mass_, keep_;
   std::vector<double> seen_;
+  // compose: ns's pattern, composed_'s values in system_'s storage, ns's entries' positions
+  std::vector<GlobalId> pattern_;
+  std::vector<double> base_;
+  std::vector<std::size_t> where_;
   std::vector<LocalId> crack_points_;
   std::vector<char> crack_held_;
   std::vector<std::vector<std::pair<GlobalId, double>>> crack_coupling_;

@@ -357,6 +357,7 @@ class SolidSolver : public Mechanics, public Skeleton {
     pore_work_ += w;
     projection_work_ += w;
   }
+  double projection_work() const { return projection_work_; }
   // The rest of the step: boundary layers, forces at t + dt, work, breakage, velocities.
   void finish(double t, double dt) override {
     ScopedRegion region("mupm::Solid::step");
