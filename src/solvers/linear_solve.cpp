@@ -76,10 +76,17 @@ void LinearSolve::refresh() {
   if (impl_->a.is_null())
     throw std::logic_error("LinearSolve::refresh before set_matrix");
   ++setups_;
-  if (impl_->prec.is_null())  // Preconditioner = None
+  if (set_.preconditioner == "None")
     return;
-  // After an ILU breakdown on this graph the preconditioner stays Jacobi (its new diagonal):
-  // a stalled ILU solve costs Maximum Iterations, set_matrix tries ILU again.
+  // Every new set of values starts with the settings' preconditioner, as set_matrix does: a
+  // restart, which calls set_matrix, then takes the same path as the straight run (after an ILU
+  // breakdown each step pays a failed ILU solve before Jacobi's).
+  const bool jacobi = set_.preconditioner == "Jacobi";
+  if (impl_->prec.is_null() || jacobi_ != jacobi) {
+    jacobi_ = jacobi;
+    precondition();
+    return;
+  }
   int failed = 0, anywhere = 0;
   try {
     impl_->prec->compute();

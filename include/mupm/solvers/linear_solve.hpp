@@ -61,8 +61,8 @@ class LinearSolve {
   const LinearSolveSettings& settings() const { return set_; }
   // Preconditioner set-ups since construction (for the benchmarks).
   long long setups() const { return setups_; }
-  // ILU breakdowns since construction, each answered with Jacobi for that matrix (solve(); kept
-  // by refresh until the next set_matrix).
+  // ILU breakdowns since construction, each answered with Jacobi for that matrix's values
+  // (solve()).
   long long fallbacks() const { return fallbacks_; }
 
  private:
