@@ -94,8 +94,15 @@ void LinearSolve::refresh() {
     failed = 1;
   }
   Teuchos::reduceAll(*impl_->a->getComm(), Teuchos::REDUCE_MAX, failed, Teuchos::outArg(anywhere));
-  if (anywhere)
-    precondition();  // Jacobi for these values (precondition's fallback)
+  if (!anywhere)
+    return;
+  // An ILU whose factorization throws: Jacobi for these values at once, as precondition() does
+  // (trying the ILU again there would only fail again).
+  if (jacobi_)
+    throw std::runtime_error("LinearSolve: the Jacobi preconditioner could not be computed");
+  jacobi_ = true;
+  ++fallbacks_;
+  precondition();
 }
 
 // The preconditioner of the current matrix: the settings', or Jacobi after an ILU breakdown.
