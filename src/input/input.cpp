@@ -199,7 +199,7 @@ RCP<ParameterList> valid_parameters() {
     ParameterList& d = pl->sublist("Discretization", false,
                                    "The point grid: a box of cell-centred points of spacing "
                                    "Spacing, boundary layers, pre-cracks and named regions.");
-    d.set("Dimension", 2, "2 (plane strain) or 3.",
+    d.set("Dimension", 2, "2 (plane strain, or plane stress: Plane) or 3.",
           rcp(new Teuchos::EnhancedNumberValidator<int>(2, 3)));
     d.set("Spacing", 1.0, "Point spacing dx [m] (required, > 0).", positive());
     d.set("Counts", Array<int>(),
@@ -214,7 +214,17 @@ RCP<ParameterList> valid_parameters() {
           "Horizon delta as a multiple of Spacing (used unless Horizon is given).", positive());
     d.set("Horizon", 0.0, "Horizon delta [m]; 0: use Horizon Factor. Give one of the two.",
           at_least(0.0));
-    d.set("Thickness", 1.0, "Out-of-plane thickness [m] (2D only).", positive());
+    d.set("Thickness", 1.0,
+          "Out-of-plane thickness h [m] (2D only): point volumes dx^2 h, so the CSV's energies, "
+          "reactions and water masses are those of the thickness h; J is per unit thickness; "
+          "Fluid Source and Fracture Source values are per metre of thickness.",
+          positive());
+    d.set("Plane", std::string("Strain"),
+          "2D only. Strain: plane strain (eps_zz = 0). Stress: plane stress (sigma_zz = 0: the "
+          "law's in-plane lambda becomes 2 lambda mu / (lambda + 2 mu); derivation in "
+          "include/mupm/laws/micropolar_elastic.hpp), for Solver->Physics = Micropolar Solid "
+          "with Materials->Model = Micropolar Elastic (not yet with pore water or plasticity).",
+          plane_options().validator());
     d.set("Boundary Layer Horizons", 2.0,
           "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
           "default) gives the layer points next to the body full families too, which the "
@@ -1033,6 +1043,23 @@ void check_dimension_arrays(ParameterList& input) {
       throw InputError("Error, " + path_of(input.sublist("Materials"), "Porosity") +
                        " must be > 0 for Solver->Physics = " + physics +
                        " (the pores hold the water).");
+  }
+  const ParameterList& disc = input.sublist("Discretization");
+  const ParameterList& materials = input.sublist("Materials");
+  if (plane_options()(disc.get<std::string>("Plane")) == Plane::Stress) {
+    if (dim != 2)
+      throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is for Dimension = 2.");
+    if (phys != Physics::MicropolarSolid)
+      throw InputError("Error, " + path_of(disc, "Plane") +
+                       " = Stress is not implemented with Solver->Physics = " + physics +
+                       " (the pore water's plane-stress coupling is not derived yet): use "
+                       "Plane = Strain.");
+    if (constitutive_model_options()(materials.get<std::string>("Model")) !=
+        ConstitutiveModel::MicropolarElastic)
+      throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +
+                       path_of(materials, "Model") + " = " + materials.get<std::string>("Model") +
+                       " (its return mapping keeps sigma_zz): "
+                       "use Plane = Strain.");
   }
   if (has_solid(phys)) {
     const ParameterList& m = input.sublist("Materials");

@@ -103,6 +103,10 @@ const Options<ContourUnits>& contour_units_options() {
       "Units", {{"Spacings", ContourUnits::Spacings}, {"Metres", ContourUnits::Metres}});
   return o;
 }
+const Options<Plane>& plane_options() {
+  static const Options<Plane> o("Plane", {{"Strain", Plane::Strain}, {"Stress", Plane::Stress}});
+  return o;
+}
 const Options<BondBreaking>& bond_breaking_options() {
   static const Options<BondBreaking> o("Bond Breakage", {{"None", BondBreaking::None},
                                                          {"Energy", BondBreaking::Energy},
@@ -383,11 +387,14 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.damping = solver.get<double>("Damping");
 
   m.constitutive_model = constitutive_model_options()(materials.get<std::string>("Model"));
+  auto law = MicropolarElastic::from_bulk_shear(
+      materials.get<double>("Bulk Modulus"), materials.get<double>("Shear Modulus"),
+      materials.get<double>("Micropolar Shear Modulus"), materials.get<double>("Length Scale"));
+  if (Dim == 2 &&
+      plane_options()(input.sublist("Discretization").get<std::string>("Plane")) == Plane::Stress)
+    law = law.plane_stress();
   m.solid = solid_params<Dim>(
-      MicropolarElastic::from_bulk_shear(
-          materials.get<double>("Bulk Modulus"), materials.get<double>("Shear Modulus"),
-          materials.get<double>("Micropolar Shear Modulus"), materials.get<double>("Length Scale")),
-      m.grid, materials.get<double>("Stabilization"),
+      law, m.grid, materials.get<double>("Stabilization"),
       stabilization_modulus_options()(materials.get<std::string>("Stabilization Modulus")));
   const double deg = kPi / 180;
   m.plasticity.friction = materials.get<double>("Friction Angle") * deg;

@@ -281,6 +281,49 @@ TEST(Input, SolidAndBoundaryConditions) {
   EXPECT_DOUBLE_EQ(bcs[0].time.rate(2.0), -0.5);
 }
 
+// Discretization->Plane = Stress gives the elastic law lambda* = 2 lambda mu / (lambda + 2 mu)
+// (K = 1e8, mu = 5e7: lambda = 6.667e7, lambda* = 3.333e7); Strain keeps lambda. Plane stress
+// is refused in 3D, with pore water and with Drucker-Prager, naming the parameters.
+TEST(Input, PlaneStress) {
+  const std::string stress = "<Parameter name=\"Plane\" type=\"string\" value=\"Stress\"/>";
+  const double lambda = 1e8 - 2 * 5e7 / 3.0, mu = 5e7;
+  for (const bool plane_stress : {false, true}) {
+    auto pl = parse_input(xml(kOk + (plane_stress ? stress : std::string())));
+    validate_input(*pl);
+    const auto m = model_from_input<2>(*pl);
+    EXPECT_DOUBLE_EQ(m.solid.law.lambda,
+                     plane_stress ? 2 * lambda * mu / (lambda + 2 * mu) : lambda);
+    EXPECT_DOUBLE_EQ(m.solid.law.mu, mu);
+  }
+  expect_error(xml("<Parameter name=\"Dimension\" type=\"int\" value=\"3\"/>"
+                   "<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
+                   "<Parameter name=\"Counts\" type=\"Array(int)\" value=\"{10, 8, 4}\"/>" +
+                   stress),
+               {"mupm->Discretization->Plane = Stress", "Dimension = 2"});
+  expect_error(
+      xml(kOk + stress,
+          "<ParameterList name=\"Solver\"><Parameter name=\"Physics\" type=\"string\" "
+          "value=\"Hydro-Mechanical\"/></ParameterList><ParameterList name=\"Fluid\">"
+          "<Parameter name=\"Hydraulic Conductivity\" type=\"double\" value=\"1e-5\"/>"
+          "</ParameterList><ParameterList name=\"Materials\">"
+          "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+          "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+          "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+          "<Parameter name=\"Porosity\" type=\"double\" value=\"0.3\"/>"
+          "</ParameterList>"),
+      {"mupm->Discretization->Plane = Stress", "Physics = Hydro-Mechanical", "Plane = Strain"});
+  expect_error(xml(kOk + stress,
+                   "<ParameterList name=\"Materials\">"
+                   "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+                   "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+                   "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+                   "<Parameter name=\"Model\" type=\"string\" value=\"Micropolar Drucker-Prager\"/>"
+                   "<Parameter name=\"Cohesion\" type=\"double\" value=\"1e4\"/>"
+                   "</ParameterList>"),
+               {"mupm->Discretization->Plane = Stress",
+                "mupm->Materials->Model = Micropolar Drucker-Prager"});
+}
+
 TEST(Input, MalformedXml) {
   EXPECT_THROW(parse_input("<ParameterList name=\"mupm\"><Parameter name="), InputError);
 }

@@ -67,6 +67,34 @@ TEST(SolidPatch, AffineStrainExactEverywhere3D) {
       ASSERT_NEAR(eps(i, k), expected[k], 1e-14) << "point " << i;
 }
 
+// Plane stress (Discretization->Plane = Stress, MicropolarElastic::plane_stress): a thin
+// plate's uniaxial stress sigma_xx = t has eps_xx = t/E, eps_yy = -nu t/E (E, nu the 3D
+// constants). Given that affine field, every point's law gives sigma_yy = 0 and sigma_xx = t, and
+// pass 1 books the energy density t^2/(2E) (the stabilization's is zero for an affine field).
+// Plane strain's lambda would give sigma_yy = 0.43 t here (Example 2's skeleton, nu = 0.30).
+TEST(SolidPatch, PlaneStressUniaxialStress) {
+  const auto solid = MicropolarElastic::from_bulk_shear(60e9, 27.7e9, 14e9, 4e-3);
+  const auto law = solid.plane_stress();
+  const double E = solid.young(), nu = solid.poisson(), t = 1e6, dx = 1e-3;
+  double eps[4] = {t / E, 0, 0, -nu * t / E}, kappa[2] = {0, 0}, sigma[4], m[2];
+  law.stress<2>(eps, kappa, sigma, m);
+  EXPECT_NEAR(sigma[0], t, 1e-12 * t);
+  EXPECT_NEAR(sigma[3], 0.0, 1e-12 * t);
+  EXPECT_NEAR(sigma[1], 0.0, 1e-12 * t);
+  EXPECT_NEAR(sigma[2], 0.0, 1e-12 * t);
+  Body<2> body(test::box<2>({12, 9}, 3.015, dx), law, 0.5);
+  body.set([&](const double* x, double* u, double* th) {
+    u[0] = eps[0] * x[0];
+    u[1] = eps[3] * x[1];
+    th[0] = 0;
+  });
+  body.forces();
+  auto en = Kokkos::create_mirror_view_and_copy(HostSpace(), body.st.energy);
+  const double w = t * t / (2 * E), volume = dx * dx;  // thickness 1 m
+  for (std::size_t i = 0; i < body.pts().n_owned; ++i)
+    ASSERT_NEAR(en(i) / volume, w, 1e-9 * w) << "point " << i;
+}
+
 // Linear theta: kappa = grad theta at every point (eq 51); eps exact where the family is
 // symmetric (the mean rotation of a bond adds a term odd in xi, zero only over a full family).
 TEST(SolidPatch, LinearRotationGivesExactWryness) {

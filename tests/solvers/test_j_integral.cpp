@@ -2,17 +2,20 @@
 // criterion (Algorithm 3; include/mupm/solvers/j_integral.hpp).
 //
 // The LEFM K-fields. A plate with a straight crack along y = y_t ending at (x_t, y_t) is given the
-// plane-strain Williams displacement field of a mode I (or mode II) crack of stress-intensity
-// factor K, and theta = its rotation (du_y/dx - du_x/dy)/2, so that the micropolar part of the
-// strain vanishes; mu_c and l are small (the classical limit). Away from the tip the field is an
-// equilibrium field of the material, so J on every contour is the closed form
-// K^2 (1 - nu^2)/E (mode I and II alike). A factor or sign error in either the energy term or
+// Williams displacement field of a mode I (or mode II) crack of stress-intensity factor K
+// (plane strain: kappa = 3 - 4 nu; plane stress: (3 - nu)/(1 + nu)), and theta = its rotation
+// (du_y/dx - du_x/dy)/2, so that the micropolar part of the strain vanishes; mu_c and l are
+// small (the classical limit). Away from the tip the field is an equilibrium field of the
+// material, so J on every contour is the closed form K^2 (1 - nu^2)/E in plane strain and K^2/E
+// in plane stress (Discretization->Plane = Stress, the law's MicropolarElastic::plane_stress),
+// mode I and II alike. A factor or sign error in either the energy term or
 // the bond term moves J by tens of percent (they are of the same size on these contours).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <tuple>
 #include <vector>
 
 #include "mupm/input/model.hpp"
@@ -31,7 +34,7 @@ const MicropolarElastic kClassical =
 struct KField {
   double K = 1e6;  // stress-intensity factor [Pa m^0.5]
   bool mode2 = false;
-  double mu = 0, kappa = 0;  // shear modulus, 3 - 4 nu (plane strain)
+  double mu = 0, kappa = 0;  // shear modulus, Kolosov's constant
   double xt = 0, yt = 0;     // tip
   void u(double x, double y, double* out) const {
     const double dx = x - xt, dy = y - yt;
@@ -107,23 +110,26 @@ JIntegralParams contours(std::vector<double> half_spacings, double dx) {
   return jp;
 }
 
-// The K-field of kClassical with its tip at the centre of cracked_plate(80, ...).
-KField centre_field(bool mode2) {
+// The K-field of kClassical with its tip at the centre of cracked_plate(80, ...), in plane strain
+// or plane stress (nu the 3D Poisson ratio).
+KField centre_field(bool mode2, bool plane_stress = false) {
+  const double nu = kClassical.poisson();
   KField f;
   f.mode2 = mode2;
   f.mu = kClassical.mu;
-  f.kappa = 3 - 4 * kClassical.poisson();
+  f.kappa = plane_stress ? (3 - nu) / (1 + nu) : 3 - 4 * nu;
   f.xt = f.yt = 0.04;
   return f;
 }
 
-class JIntegralKField : public ::testing::TestWithParam<bool> {};
+// (mode II, plane stress)
+class JIntegralKField : public ::testing::TestWithParam<std::tuple<bool, bool>> {};
 
 TEST_P(JIntegralKField, MatchesLefmOnEveryContour) {
-  const bool mode2 = GetParam();
-  Plate p = cracked_plate(80, kClassical);
-  const auto& law = kClassical;
-  const KField f = centre_field(mode2);
+  const auto [mode2, plane_stress] = GetParam();
+  Plate p = cracked_plate(80, plane_stress ? kClassical.plane_stress() : kClassical);
+  const double E = kClassical.young(), nu = kClassical.poisson();
+  const KField f = centre_field(mode2, plane_stress);
   impose(p, f);
   Damage<2> damage(p.disc, 0.3, MPI_COMM_WORLD);
   damage.update();
@@ -132,15 +138,15 @@ TEST_P(JIntegralKField, MatchesLefmOnEveryContour) {
   const auto tip = j.tip();
   EXPECT_DOUBLE_EQ(tip[0], 0.04);
   EXPECT_DOUBLE_EQ(tip[1], 0.04);
-  const double exact = f.K * f.K * (1 - law.poisson() * law.poisson()) / law.young();
+  const double exact = f.K * f.K * (plane_stress ? 1.0 : 1 - nu * nu) / E;
   const auto v = j.evaluate();
   double lo = 1e300, hi = -1e300;
   for (std::size_t c = 0; c < v.size(); ++c) {
     std::printf(
-        "mode %s, contour %zu: J = %.5g (translational %.5g, rotational %.5g), "
+        "mode %s, plane %s, contour %zu: J = %.5g (translational %.5g, rotational %.5g), "
         "closed form %.5g, error %.2f %%\n",
-        mode2 ? "II" : "I", c + 1, v[c].total, v[c].translational, v[c].rotational, exact,
-        100 * (v[c].total / exact - 1));
+        mode2 ? "II" : "I", plane_stress ? "stress" : "strain", c + 1, v[c].total,
+        v[c].translational, v[c].rotational, exact, 100 * (v[c].total / exact - 1));
     EXPECT_NEAR(v[c].total / exact, 1.0, 0.01) << "contour " << c + 1;
     // The classical limit: the micro-rotational part is small (measured 0.04 % of J).
     EXPECT_LT(std::abs(v[c].rotational), 0.005 * exact) << "contour " << c + 1;
@@ -150,7 +156,8 @@ TEST_P(JIntegralKField, MatchesLefmOnEveryContour) {
   EXPECT_LT((hi - lo) / exact, 0.005) << "path independence";
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, JIntegralKField, ::testing::Values(false, true));
+INSTANTIATE_TEST_SUITE_P(ModesPlanes, JIntegralKField,
+                         ::testing::Combine(::testing::Bool(), ::testing::Bool()));
 
 // Intact bonds (over all ranks) that cross the horizontal segment y = yc, x in [x0, x1]: the
 // test's own geometry.

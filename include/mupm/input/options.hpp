@@ -38,6 +38,8 @@ enum class BondEnergyState { Effective, Total };
 enum class CrackWaterForce { FacePressure, Eq17 };
 // J-Integral->Units.
 enum class ContourUnits { Spacings, Metres };
+// Discretization->Plane (2D).
+enum class Plane { Strain, Stress };
 
 template <class E>
 class Options {
@@ -86,6 +88,7 @@ const Options<BondBreaking>& bond_breaking_options();
 const Options<BondEnergyState>& bond_energy_state_options();
 const Options<CrackWaterForce>& crack_water_force_options();
 const Options<ContourUnits>& contour_units_options();
+const Options<Plane>& plane_options();
 const Options<BoundaryCondition::Kind>& boundary_condition_options();
 const Options<TimeFunction::Kind>& time_function_options();
 // Boundary Conditions->NAME->Component: the axis (x, y, z) as 0, 1, 2.

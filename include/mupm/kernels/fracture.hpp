@@ -12,10 +12,11 @@
 //   above it, measure int_0^delta int_z^delta int_0^arccos(z/r) 2 pi r^2 sin(phi) dphi dr dz
 //   = int_0^delta int_z^delta 2 pi r (r - z) dr dz = pi delta^4 / 4, so W_cr = 4 G_cr/(pi delta^4)
 //   (eq 36).
-//   2D plane strain, thickness h: a point at distance z from a crack line of length L (area L h)
-//   has volume h dA; its bonds crossing the line are those of length r in (z, delta) within the
-//   angle 2 arccos(z/r): measure per unit line length h^2 int_0^delta int_z^delta 2 r arccos(z/r)
-//   dr dz = h^2 (2 delta^3 / 3), i.e. h (2 delta^3 / 3) per unit crack area, so
+//   2D (plane strain or stress: W_cr holds no modulus), thickness h: a point at distance z from
+//   a crack line of length L (area L h) has volume h dA; its bonds crossing the line are those
+//   of length r in (z, delta) within the angle 2 arccos(z/r): measure per unit line length
+//   h^2 int_0^delta int_z^delta 2 r arccos(z/r) dr dz = h^2 (2 delta^3 / 3), i.e.
+//   h (2 delta^3 / 3) per unit crack area, so
 //   W_cr = 3 G_cr / (2 h delta^3).
 // W is counted once per pair (both directed copies of a bond hold the same W, each releases half
 // of W V_i V_j). tests/kernels/test_fracture.cpp opens a straight crack through a uniform grid

@@ -19,6 +19,19 @@ struct MicropolarElastic {
   static MicropolarElastic from_bulk_shear(double K, double mu, double mu_c, double l) {
     return {K - 2.0 * mu / 3.0, mu, mu_c, l};
   }
+  // 2D plane stress (Discretization->Plane = Stress): sigma_zz = 0 with eps_zz free. Eq 80's
+  // sigma_zz = lambda (eps_kk + eps_zz) + 2 mu eps_zz (k in-plane; mu_c does not enter, eps_zz
+  // having no antisymmetric part) vanishes for eps_zz = -lambda eps_kk / (lambda + 2 mu), so the
+  // in-plane stress is eq 80 with lambda* = 2 lambda mu / (lambda + 2 mu); mu, mu_c and the
+  // couple stresses m_zx, m_zy (eq 81, gradients of theta_z in the plane) are unchanged, and
+  // m_xz, m_yz stay zero as in plane strain (no in-plane rotation components). Every constant
+  // derived from the law follows: the P-wave speed sqrt((lambda* + 2 mu)/rho) =
+  // sqrt(E / (rho (1 - nu^2))), the in-plane bulk modulus lambda* + mu of the stabilization
+  // modulus, the stable step, poisson() = nu / (1 + nu) (the 2D ratio that turns the
+  // plane-strain formulas into plane-stress ones), the J-integral's energy density.
+  MicropolarElastic plane_stress() const {
+    return {2 * lambda * mu / (lambda + 2 * mu), mu, mu_c, length};
+  }
   double young() const { return mu * (3 * lambda + 2 * mu) / (lambda + mu); }
   double poisson() const { return lambda / (2 * (lambda + mu)); }
   // Couple-stress modulus B of m = B kappa: eq 81, m_ij = 1/2 mu l^2 kappa_ij.

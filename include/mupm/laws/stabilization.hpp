@@ -17,7 +17,8 @@ namespace mupm {
 //   expansion eps = e 1 applied as R = eps xi equals the elastic one:
 //   3D: 1/2 int_0^delta (12 D / r^3) e^2 r^2 4 pi r^2 dr = 12 pi D delta^2 e^2 = (9K/2) e^2
 //       => D = 3K / (8 pi delta^2),
-//   2D (plane strain, thickness h, dV = h 2 pi r dr, K2 = lambda + mu the in-plane bulk modulus):
+//   2D (thickness h, dV = h 2 pi r dr, K2 = lambda + mu the in-plane bulk modulus; plane stress:
+//   lambda* of MicropolarElastic::plane_stress in place of lambda):
 //       1/2 int_0^delta (12 D / r^3) e^2 r^2 h 2 pi r dr = 12 pi D h delta e^2 = 2 K2 e^2
 //       => D = K2 / (6 pi h delta).
 //   The same D enters C2 = D/|xi| (eq 70), as in the paper.
