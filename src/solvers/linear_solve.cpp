@@ -20,6 +20,20 @@ using MV = Tpetra::MultiVector<double, LocalId, GlobalId>;
 using OP = Tpetra::Operator<double, LocalId, GlobalId>;
 using RowMatrix = Tpetra::RowMatrix<double, LocalId, GlobalId>;
 using Preconditioner = Ifpack2::Preconditioner<double, LocalId, GlobalId>;
+
+// Runs f on every rank; true when it threw on any. Decided together, so that every rank then
+// takes the same path.
+template <class F>
+bool fails_anywhere(const Teuchos::Comm<int>& comm, F&& f) {
+  int failed = 0, anywhere = 0;
+  try {
+    f();
+  } catch (const std::exception&) {
+    failed = 1;
+  }
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, failed, Teuchos::outArg(anywhere));
+  return anywhere != 0;
+}
 }  // namespace
 
 struct LinearSolve::Impl {
@@ -87,22 +101,19 @@ void LinearSolve::refresh() {
     precondition();
     return;
   }
-  int failed = 0, anywhere = 0;
-  try {
-    impl_->prec->compute();
-  } catch (const std::exception&) {
-    failed = 1;
-  }
-  Teuchos::reduceAll(*impl_->a->getComm(), Teuchos::REDUCE_MAX, failed, Teuchos::outArg(anywhere));
-  if (!anywhere)
+  if (!fails_anywhere(*impl_->a->getComm(), [&] { impl_->prec->compute(); }))
     return;
   // An ILU whose factorization throws: Jacobi for these values at once, as precondition() does
   // (trying the ILU again there would only fail again).
+  fall_back_to_jacobi();
+  precondition();
+}
+
+void LinearSolve::fall_back_to_jacobi() {
   if (jacobi_)
     throw std::runtime_error("LinearSolve: the Jacobi preconditioner could not be computed");
   jacobi_ = true;
   ++fallbacks_;
-  precondition();
 }
 
 // The preconditioner of the current matrix: the settings', or Jacobi after an ILU breakdown.
@@ -126,23 +137,14 @@ void LinearSolve::precondition() {
       p.set("relaxation: sweeps", 1);
     }
     Teuchos::RCP<const RowMatrix> rows = impl_->a;
-    int failed = 0, anywhere = 0;  // decided together: every rank then takes the same path
-    try {
-      impl_->prec = Ifpack2::Factory::create<RowMatrix>(jacobi_ ? "RELAXATION" : "RILUK", rows);
-      impl_->prec->setParameters(p);
-      impl_->prec->initialize();
-      impl_->prec->compute();
-    } catch (const std::exception&) {
-      failed = 1;
-    }
-    Teuchos::reduceAll(*impl_->a->getComm(), Teuchos::REDUCE_MAX, failed,
-                       Teuchos::outArg(anywhere));
-    if (!anywhere)
+    if (!fails_anywhere(*impl_->a->getComm(), [&] {
+          impl_->prec = Ifpack2::Factory::create<RowMatrix>(jacobi_ ? "RELAXATION" : "RILUK", rows);
+          impl_->prec->setParameters(p);
+          impl_->prec->initialize();
+          impl_->prec->compute();
+        }))
       break;
-    if (jacobi_)
-      throw std::runtime_error("LinearSolve: the Jacobi preconditioner could not be computed");
-    jacobi_ = true;
-    ++fallbacks_;
+    fall_back_to_jacobi();
   }
   impl_->problem->setRightPrec(impl_->prec);
 }

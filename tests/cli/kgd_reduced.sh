@@ -8,9 +8,9 @@
 # half-length a holding the injected volume V = Q0 t (per unit thickness) opens elliptically,
 # V = 2 pi p a^2 / E', so p = E' Q0 t / (2 pi a^2) and the mouth opening 4 p a / E' = 2 V / (pi a).
 # a is the network's half-length: its farthest point from the source's centre (dx/2 past the
-# pre-crack's tip, whose cell it is). From 5 ms (the impulsive start's waves have crossed the
-# plate some 20 times) p_f at the mouth and the opening of the two rows next to the crack there
-# are within 10 % of the closed form; no bond breaks (LEFM's onset is later: printed).
+# pre-crack's tip, whose cell it is). From 5 ms (after the impulsive start's transient) p_f at
+# the mouth and the opening of the two rows next to the crack there are within 10 % of the
+# closed form; no bond breaks (LEFM's onset is later: printed).
 # With the plate's edges clamped instead (the input's earlier version) the undrained matrix,
 # nearly incompressible, must absorb the crack's volume: p_f was 1.27 times the closed form.
 source "$(dirname "$0")/common.sh"

@@ -67,6 +67,8 @@ class LinearSolve {
 
  private:
   void precondition();
+  // After an ILU breakdown: Jacobi from now on (counted); an error if Jacobi itself failed.
+  void fall_back_to_jacobi();
   struct Impl;
   LinearSolveSettings set_;
   Teuchos::RCP<Impl> impl_;
