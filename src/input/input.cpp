@@ -222,8 +222,10 @@ RCP<ParameterList> valid_parameters() {
     d.set("Plane", std::string("Strain"),
           "2D only. Strain: plane strain (eps_zz = 0). Stress: plane stress (sigma_zz = 0: the "
           "law's in-plane lambda becomes 2 lambda mu / (lambda + 2 mu); derivation in "
-          "include/mupm/laws/micropolar_elastic.hpp), for Solver->Physics = Micropolar Solid "
-          "with Materials->Model = Micropolar Elastic (not yet with pore water or plasticity).",
+          "include/mupm/laws/micropolar_elastic.hpp; with pore water the total sigma_zz = 0: the "
+          "pressure's in-plane coefficient becomes 2 mu / (lambda + 2 mu) and the storage gains "
+          "1 / (lambda + 2 mu)), for Solver->Physics = Micropolar Solid or Hydro-Mechanical with "
+          "Materials->Model = Micropolar Elastic (not yet with plasticity or Fracture Flow).",
           plane_options().validator());
     d.set("Boundary Layer Horizons", 2.0,
           "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
@@ -1049,11 +1051,15 @@ void check_dimension_arrays(ParameterList& input) {
   if (plane_options()(disc.get<std::string>("Plane")) == Plane::Stress) {
     if (dim != 2)
       throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is for Dimension = 2.");
-    if (phys != Physics::MicropolarSolid)
+    if (!has_solid(phys))
       throw InputError("Error, " + path_of(disc, "Plane") +
-                       " = Stress is not implemented with Solver->Physics = " + physics +
-                       " (the pore water's plane-stress coupling is not derived yet): use "
-                       "Plane = Strain.");
+                       " = Stress needs a skeleton (Solver->Physics = " + physics +
+                       " has none): use Plane = Strain.");
+    if (has_fluid(phys) && input.sublist("Fracture").get<bool>("Fracture Flow"))
+      throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +
+                       path_of(input.sublist("Fracture"), "Fracture Flow") +
+                       " = true (the crack water's coupling with the plate's thickness is not "
+                       "derived): use Plane = Strain.");
     if (constitutive_model_options()(materials.get<std::string>("Model")) !=
         ConstitutiveModel::MicropolarElastic)
       throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +

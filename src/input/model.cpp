@@ -390,12 +390,16 @@ Model<Dim> model_from_input(const ParameterList& input) {
   auto law = MicropolarElastic::from_bulk_shear(
       materials.get<double>("Bulk Modulus"), materials.get<double>("Shear Modulus"),
       materials.get<double>("Micropolar Shear Modulus"), materials.get<double>("Length Scale"));
-  if (Dim == 2 &&
-      plane_options()(input.sublist("Discretization").get<std::string>("Plane")) == Plane::Stress)
+  const bool plane_stress =
+      Dim == 2 &&
+      plane_options()(input.sublist("Discretization").get<std::string>("Plane")) == Plane::Stress;
+  if (plane_stress)
     law = law.plane_stress();
   m.solid = solid_params<Dim>(
       law, m.grid, materials.get<double>("Stabilization"),
       stabilization_modulus_options()(materials.get<std::string>("Stabilization Modulus")));
+  if (plane_stress)
+    m.solid.pore = law.plane_stress_coupling();
   const double deg = kPi / 180;
   m.plasticity.friction = materials.get<double>("Friction Angle") * deg;
   m.plasticity.dilation = materials.get<double>("Dilation Angle") * deg;
@@ -424,6 +428,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
             : fluid.get<double>("Hydraulic Conductivity") / (rho_w * kStandardGravity),
       fluid.get<double>("Flow Stabilization"));
   m.fluid.water_density = rho_w;
+  m.fluid.pore = m.solid.pore;
   m.fluid.bulk_modulus = fluid.get<bool>("Incompressible")
                              ? std::numeric_limits<double>::infinity()
                              : fluid.get<double>("Fluid Bulk Modulus");

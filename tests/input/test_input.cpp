@@ -282,36 +282,56 @@ TEST(Input, SolidAndBoundaryConditions) {
 }
 
 // Discretization->Plane = Stress gives the elastic law lambda* = 2 lambda mu / (lambda + 2 mu)
-// (K = 1e8, mu = 5e7: lambda = 6.667e7, lambda* = 3.333e7); Strain keeps lambda. Plane stress
-// is refused in 3D, with pore water and with Drucker-Prager, naming the parameters.
+// (K = 1e8, mu = 5e7: lambda = 6.667e7, lambda* = 3.333e7); Strain keeps lambda. With pore water
+// the pressure's coefficient is 2 mu / (lambda + 2 mu) = 0.6 and the storage gains
+// 1 / (lambda + 2 mu) = 6e-9 / Pa in both the solid's and the fluid's parameters (1 and 0 in plane
+// strain). Plane stress is refused in 3D, without a skeleton, with Fracture Flow and with
+// Drucker-Prager, naming the parameters.
 TEST(Input, PlaneStress) {
   const std::string stress = "<Parameter name=\"Plane\" type=\"string\" value=\"Stress\"/>";
   const double lambda = 1e8 - 2 * 5e7 / 3.0, mu = 5e7;
-  for (const bool plane_stress : {false, true}) {
-    auto pl = parse_input(xml(kOk + (plane_stress ? stress : std::string())));
-    validate_input(*pl);
-    const auto m = model_from_input<2>(*pl);
-    EXPECT_DOUBLE_EQ(m.solid.law.lambda,
-                     plane_stress ? 2 * lambda * mu / (lambda + 2 * mu) : lambda);
-    EXPECT_DOUBLE_EQ(m.solid.law.mu, mu);
-  }
+  const std::string materials =
+      "<ParameterList name=\"Materials\">"
+      "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+      "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+      "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+      "<Parameter name=\"Porosity\" type=\"double\" value=\"0.3\"/>"
+      "</ParameterList>";
+  auto physics = [&](const char* name, const std::string& fracture = "") {
+    return "<ParameterList name=\"Solver\"><Parameter name=\"Physics\" type=\"string\" value=\"" +
+           std::string(name) +
+           "\"/></ParameterList><ParameterList name=\"Fluid\">"
+           "<Parameter name=\"Hydraulic Conductivity\" type=\"double\" value=\"1e-5\"/>"
+           "</ParameterList>" +
+           materials + fracture;
+  };
+  for (const bool plane_stress : {false, true})
+    for (const bool water : {false, true}) {
+      SCOPED_TRACE(std::string(plane_stress ? "stress" : "strain") + (water ? ", water" : ""));
+      auto pl = parse_input(xml(kOk + (plane_stress ? stress : std::string()),
+                                water ? physics("Hydro-Mechanical") : std::string()));
+      validate_input(*pl);
+      const auto m = model_from_input<2>(*pl);
+      EXPECT_DOUBLE_EQ(m.solid.law.lambda,
+                       plane_stress ? 2 * lambda * mu / (lambda + 2 * mu) : lambda);
+      EXPECT_DOUBLE_EQ(m.solid.law.mu, mu);
+      for (const PoreCoupling& c : {m.solid.pore, m.fluid.pore}) {
+        EXPECT_DOUBLE_EQ(c.biot, plane_stress ? 2 * mu / (lambda + 2 * mu) : 1.0);
+        EXPECT_DOUBLE_EQ(c.lateral_compliance, plane_stress ? 1 / (lambda + 2 * mu) : 0.0);
+      }
+    }
   expect_error(xml("<Parameter name=\"Dimension\" type=\"int\" value=\"3\"/>"
                    "<Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
                    "<Parameter name=\"Counts\" type=\"Array(int)\" value=\"{10, 8, 4}\"/>" +
                    stress),
                {"mupm->Discretization->Plane = Stress", "Dimension = 2"});
+  expect_error(xml(kOk + stress, physics("Pore Fluid")),
+               {"mupm->Discretization->Plane = Stress", "Physics = Pore Fluid", "Plane = Strain"});
   expect_error(
-      xml(kOk + stress,
-          "<ParameterList name=\"Solver\"><Parameter name=\"Physics\" type=\"string\" "
-          "value=\"Hydro-Mechanical\"/></ParameterList><ParameterList name=\"Fluid\">"
-          "<Parameter name=\"Hydraulic Conductivity\" type=\"double\" value=\"1e-5\"/>"
-          "</ParameterList><ParameterList name=\"Materials\">"
-          "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
-          "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
-          "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
-          "<Parameter name=\"Porosity\" type=\"double\" value=\"0.3\"/>"
-          "</ParameterList>"),
-      {"mupm->Discretization->Plane = Stress", "Physics = Hydro-Mechanical", "Plane = Strain"});
+      xml(kOk + stress, physics("Hydro-Mechanical",
+                                "<ParameterList name=\"Fracture\"><Parameter name=\"Fracture "
+                                "Flow\" type=\"bool\" value=\"true\"/></ParameterList>")),
+      {"mupm->Discretization->Plane = Stress", "mupm->Fracture->Fracture Flow = true"});
   expect_error(xml(kOk + stress,
                    "<ParameterList name=\"Materials\">"
                    "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"

@@ -334,7 +334,8 @@ struct Terzaghi {
   double c_v = H * H / t_c;
   double mobility = c_v * S;
   double t_r = 10 * transit;
-  double Gp = 1.0;  // Solver->Pressure Stabilization (Semi-Implicit)
+  double Gp = 1.0;    // Solver->Pressure Stabilization (Semi-Implicit)
+  PoreCoupling pore;  // plane stress: plane_stress_column()
 
   double closed_form(double z, double t) const {
     double s = 0;
@@ -397,7 +398,8 @@ struct ColumnRun {
     }
     for (auto& bc : bcs)
       bc.mirrored = mirrored && bc.kind == BoundaryCondition::PorePressure;
-    const SolidParams sp = solid_params(tz.law, g, 0.5);
+    SolidParams sp = solid_params(tz.law, g, 0.5);
+    sp.pore = tz.pore;
     SolidSolver<2>::Settings set;
     set.rho_s = tz.rho_s;
     set.rho_w = tz.rho_w;
@@ -408,6 +410,7 @@ struct ColumnRun {
     fp.water_density = tz.rho_w;
     fp.semi_implicit = semi_implicit;
     fp.projection_stabilization = tz.Gp;
+    fp.pore = tz.pore;
     set.semi_implicit = semi_implicit;
     fluid = std::make_unique<FluidSolver<2>>(disc, fp, bcs, MPI_COMM_WORLD);
     if (semi_implicit)
@@ -613,6 +616,57 @@ TEST(FluidSolverLong, TerzaghiSemiImplicitMirrored) {
   }
 }
 
+// Terzaghi in plane stress (Discretization->Plane = Stress with pore water: the law's
+// plane_stress() and its PoreCoupling, include/mupm/laws/micropolar_elastic.hpp). The closed form
+// keeps its shape; its constants follow from the 3D lambda, mu with eps_xx = 0 (walls) and the
+// total sigma_zz = lambda (eps_yy + eps_zz) + 2 mu eps_zz - p = 0:
+//   eps_zz = (p - lambda eps_yy) / (lambda + 2 mu),
+//   sigma_yy = M* eps_yy - b p,   M* = 4 mu (lambda + mu) / (lambda + 2 mu),   b = 2 mu / (lambda +
+//   2 mu), water: (phi / K_w) dp/dt + d(eps_yy + eps_zz)/dt = flow,   eps_yy + eps_zz = b eps_yy +
+//   p / (lambda + 2 mu).
+// Under the load q (sigma_yy = -q) d eps_yy = (b dp - dq) / M*, so the storage is S = phi/K_w +
+// 1/(lambda + 2 mu) + b^2/M* = phi/K_w + 1/(lambda + mu), c_v = (k/mu_w) / S and Skempton's
+// p0 = q b / (M* S) = q / (2 (lambda + mu) S): incompressible water takes half the load (plane
+// strain: all of it). The wave that sets the explicit step is the undrained one, M* + b^2 /
+// (phi/K_w + 1/(lambda + 2 mu)); semi-implicit, the drained M*.
+Terzaghi plane_stress_column(double Kw, int N, double transits, bool semi_implicit) {
+  Terzaghi tz;
+  const double lam = tz.law.lambda, mu = tz.law.mu;
+  tz.law = tz.law.plane_stress();
+  tz.pore = tz.law.plane_stress_coupling();
+  tz.Kw = Kw;
+  tz.M = 4 * mu * (lam + mu) / (lam + 2 * mu);
+  tz.S = tz.phi / Kw + 1 / (lam + mu);
+  tz.p0 = tz.q / (2 * (lam + mu) * tz.S);
+  const double b = 2 * mu / (lam + 2 * mu);
+  const double modulus = semi_implicit ? tz.M : tz.M + b * b / (tz.phi / Kw + 1 / (lam + 2 * mu));
+  tz.c_u = std::sqrt(modulus / ((1 - tz.phi) * tz.rho_s + tz.phi * tz.rho_w));
+  return column(N, transits, tz);
+}
+
+// The mirrored column in plane stress, H = 20 dx, explicit (the explicit tests' water, K_w / phi
+// = 10 (lambda + 2 mu), 1600 transits) and semi-implicit (incompressible, 500 transits), with the
+// plane-strain columns' bounds (TerzaghiMirroredLayers, TerzaghiSemiImplicitMirrored): at T_v =
+// 0.2 and 0.5 max |p - p_cf| / p0 beyond the first 2 dx within 2 % (explicit) and 1 %
+// (semi-implicit), U within 0.01. Without the plane-stress coupling (biot = 1,
+// no lateral compliance) the incompressible column would take p0 = q, not q / 2.
+TEST(FluidSolverLong, TerzaghiPlaneStress) {
+  for (const bool semi_implicit : {false, true}) {
+    SCOPED_TRACE(semi_implicit ? "semi-implicit" : "explicit");
+    const Terzaghi plane_strain;
+    const double Kw = semi_implicit ? std::numeric_limits<double>::infinity() : plane_strain.Kw;
+    const Terzaghi tz = plane_stress_column(Kw, 20, semi_implicit ? 500 : 1600, semi_implicit);
+    if (test::world()->getRank() == 0)
+      std::printf("[ terzaghi ] plane stress, K_w = %g Pa: p0 / q = %.4f\n", Kw, tz.p0 / tz.q);
+    const TerzaghiResult r = solve_terzaghi(tz, true, 2, semi_implicit);
+    for (int k = 1; k < 3; ++k) {
+      SCOPED_TRACE("T_v = " + std::to_string(kTvs[k]));
+      EXPECT_LE(r.worst[k], semi_implicit ? 0.01 : 0.02);
+      EXPECT_NEAR(r.U[k], r.U_cf[k], 0.01);
+    }
+  }
+}
+
 // Incompressible water (no explicit step at all) with the paper's constant drained layers,
 // whose kink at the face is an error of first order in delta / H: check_richardson.
 TEST(FluidSolverLong, TerzaghiSemiImplicitIncompressible) {
@@ -699,15 +753,22 @@ struct SealedBody {
   static constexpr double dx = 0.01, L = 16 * dx, q = 1e4;
   GridSpec<2> g = test::box<2>({16, 16}, 3.015, dx);
   Discretization<2> disc;
-  MicropolarElastic law = MicropolarElastic::from_bulk_shear(10e6, 6e6, 3e6, 0.01);
+  static MicropolarElastic material() {
+    return MicropolarElastic::from_bulk_shear(10e6, 6e6, 3e6, 0.01);
+  }
+  MicropolarElastic law = material();  // in plane stress, its plane_stress()
   std::vector<BoundaryCondition> bcs;
   std::unique_ptr<FluidSolver<2>> fluid;
   std::unique_ptr<SolidSolver<2>> solid;
   StepSequence<2> seq;
   double dt = 0;
 
+  // plane_stress: Discretization->Plane = Stress (the law's plane_stress() and its
+  // PoreCoupling); explicit: Pressure Integration = Explicit (undrained split, fluid substeps);
+  // damping [1/s] of the skeleton.
   explicit SealedBody(const TimeFunction& time,
-                      double k_w = std::numeric_limits<double>::infinity()) {
+                      double k_w = std::numeric_limits<double>::infinity(),
+                      bool plane_stress = false, bool explicit_water = false, double damping = 0) {
     g.region_names = {"left", "right", "bottom", "top"};
     g.regions = {box2(-1, 0.5 * dx, -1, 1), box2(L - 0.5 * dx, 1, -1, 1), box2(-1, 1, -1, 0.5 * dx),
                  box2(-1, 1, L - 0.5 * dx, 1)};
@@ -728,21 +789,30 @@ struct SealedBody {
     }
     auto fp = fluid_params(g, 1e-12, 0.5);
     fp.bulk_modulus = k_w;
-    fp.semi_implicit = true;
+    fp.semi_implicit = !explicit_water;
     SolidSolver<2>::Settings set;
-    set.semi_implicit = true;
+    set.semi_implicit = !explicit_water;
+    set.damping = damping;
+    if (plane_stress)
+      law = law.plane_stress();
+    auto sp = solid_params(law, g, 0.5);
+    if (plane_stress)
+      sp.pore = fp.pore = law.plane_stress_coupling();
     fluid = std::make_unique<FluidSolver<2>>(disc, fp, bcs, MPI_COMM_WORLD);
-    fluid->enable_semi_implicit(LinearSolveSettings());
-    solid =
-        std::make_unique<SolidSolver<2>>(disc, solid_params(law, g, 0.5), bcs, set, MPI_COMM_WORLD);
+    if (!explicit_water)
+      fluid->enable_semi_implicit(LinearSolveSettings());
+    solid = std::make_unique<SolidSolver<2>>(disc, sp, bcs, set, MPI_COMM_WORLD);
     fluid->initialize(0, false);
     solid->initialize(0, false);
     fluid->reset_strain_reference();
     seq.mechanics = solid.get();
-    seq.skeleton = solid.get();
     seq.fluid = fluid.get();
     dt = 0.5 * solid->estimate_stable_dt();
     solid->set_time_step(dt);
+    if (explicit_water)
+      seq.substeps = std::max(1, int(std::ceil(dt / (0.5 * fluid->estimate_stable_dt()))));
+    else
+      seq.skeleton = solid.get();
   }
 };
 
@@ -775,6 +845,63 @@ TEST(FluidSolverSemiImplicit, SealedIncompressibleBodyTakesTheLoad) {
           t / t_r, worst, moved, moved / drained);
     EXPECT_LT(worst, 1e-6);
     EXPECT_LT(moved, 1e-6 * drained);
+  }
+}
+
+// Plane stress (Discretization->Plane = Stress with pore water, PoreCoupling in
+// include/mupm/laws/micropolar_elastic.hpp): the sealed body under the in-plane pressure q, with
+// sigma_zz,total = 0. Closed form from the 3D lambda, mu: the uniform in-plane strain e (eps_xx =
+// eps_yy = e) and eps_zz = (p - 2 lambda e) / (lambda + 2 mu) satisfy the in-plane balance
+// 2 lambda e + 2 mu e + lambda eps_zz - p = -q and the water's, phi p / K_w + 2 e + eps_zz = 0
+// (no flow), solved below. With incompressible water p = 2q/3 (the mean effective stress must
+// vanish, and the out-of-plane one is p), not plane strain's q, and the skeleton moves: e =
+// -q / (6 mu). The load is ramped over 10 transits of the drained wave, the skeleton damped
+// (about half critical),
+// so the body is near its static state after the ramp: the mean p within 1 % of the closed
+// form, for the semi-implicit water (incompressible) and the explicit one (K_w / phi = 10 (lambda +
+// 2 mu): the undrained split and the fluid's storage with the thickness's compliance).
+TEST(FluidSolverHydroMechanical, SealedBodyPlaneStress) {
+  const double q = SealedBody::q, L = SealedBody::L;
+  const MicropolarElastic law3 = SealedBody::material();
+  const double lam = law3.lambda, mu = law3.mu, phi = 0.3;
+  const double rho = (1 - phi) * 2000 + phi * 1000;
+  const double c_d = std::sqrt(4 * mu * (lam + mu) / (lam + 2 * mu) / rho);
+  const double t_r = 10 * L / c_d;
+  TimeFunction ramp;
+  ramp.kind = TimeFunction::Ramp;
+  ramp.ramp_time = t_r;
+  for (const bool explicit_water : {false, true}) {
+    const double k_w =
+        explicit_water ? 10 * (lam + 2 * mu) * phi : std::numeric_limits<double>::infinity();
+    // Unknowns e, eps_zz, p: the in-plane and out-of-plane total stresses and the water balance.
+    //   (2 lam + 2 mu) e + lam eps_zz - p = -q,   2 lam e + (lam + 2 mu) eps_zz - p = 0,
+    //   2 e + eps_zz + (phi / K_w) p = 0.
+    const double s = phi / k_w;
+    // From the second and third: eps_zz = -2 e - s p, so (2 lam - 2 (lam + 2 mu)) e - ((lam + 2 mu)
+    // s + 1) p = 0, e = -((lam + 2 mu) s + 1) p / (4 mu); the first then gives p.
+    const double e_per_p = -((lam + 2 * mu) * s + 1) / (4 * mu);
+    const double p_exact = -q / ((2 * lam + 2 * mu) * e_per_p + lam * (-2 * e_per_p - s) - 1);
+    SealedBody b(ramp, k_w, true, explicit_water, kPi * c_d / L);
+    const auto& pts = b.disc.points;
+    long long n = 0;
+    for (; (n + 1) * b.dt <= 1.5 * t_r; ++n)
+      b.seq.step(n, n * b.dt, b.dt);
+    double sum = 0, count = 0, strain = 0;
+    for (std::size_t i = 0; i < pts.n_owned; ++i) {
+      sum += pts.p(i);
+      count += 1;
+      strain += pts.vol_strain(i);
+    }
+    const double mean = global_sum(sum) / global_sum(count);
+    const double e = 0.5 * global_sum(strain) / global_sum(count);
+    if (test::world()->getRank() == 0)
+      std::printf(
+          "[ plane stress ] %s, K_w = %.3g Pa: mean p / q = %.5f (closed form %.5f; plane "
+          "strain's %.5f), in-plane strain %.4e (closed form %.4e)\n",
+          explicit_water ? "explicit" : "semi-implicit", k_w, mean / q, p_exact / q,
+          1 / (1 + s * (lam + mu)), e, e_per_p * p_exact);
+    EXPECT_NEAR(mean / p_exact, 1.0, 0.01);
+    EXPECT_NEAR(e / (e_per_p * p_exact), 1.0, 0.02);
   }
 }
 

@@ -41,7 +41,9 @@
 // Mass balance (eqs 14, 113-117, 143 with FORMULATION's storage):
 //   C_i dp_i/dt = -S_r,i dV_s,i/dt - div_i + s_i,   C = phi dS_r/dp + phi S_r / K_w,
 // with dV_s/dt the rate of the volumetric strain tr(eps) of the solid (eq 117) and s_i a source
-// [1/s]. Forward Euler (eqs 141, 145 with beta_3 = 0).
+// [1/s]. Forward Euler (eqs 141, 145 with beta_3 = 0). In plane stress (PoreCoupling,
+// include/mupm/laws/micropolar_elastic.hpp) S_r dV_s/dt is biot S_r dV_s/dt and C gains
+// c_z S_r d(S_r p)/dp, c_z = 1/(lambda + 2 mu): the thickness's swelling under the pressure.
 #ifndef MUPM_FLUID_HPP
 #define MUPM_FLUID_HPP
 
@@ -51,6 +53,7 @@
 #include "mupm/data/bonds.hpp"
 #include "mupm/data/points.hpp"
 #include "mupm/data/shape_tensors.hpp"
+#include "mupm/laws/micropolar_elastic.hpp"
 #include "mupm/laws/unsaturated.hpp"
 
 namespace mupm {
@@ -67,6 +70,7 @@ struct FluidParams {
   // G_p of the projection's pressure stabilization (Semi-Implicit only; include/mupm/solvers/
   // pressure_projection.hpp).
   double projection_stabilization = 1.0;
+  PoreCoupling pore;  // the skeleton's coefficient and plane stress's lateral compliance c_z
   double horizon_volume = 0;           // V_H: volume of a full continuous family
   double second_moment = 0;            // k2 = int_H |xi|^2 / Dim dV
   Kokkos::Array<double, 3> gravity{};  // g in Darcy's law (all zero: no gravity term)
@@ -93,12 +97,15 @@ struct FluidState {
 // Energy stored in the pore water per unit volume, psi(p) = int_0^p C(q) q dq (the work of
 // the pressure on the water content, dm = C dp): phi p^2 / (2 K_w) for p >= 0, and for p < 0
 // (unsaturated) the capillary part phi int q dS_r plus the compressional part, by 8-point
-// Gauss-Legendre quadrature on [p, 0]. A state function: the fluid energy balance (eqs
-// 147-149) compares its change with the power the update books step by step.
+// Gauss-Legendre quadrature on [p, 0]. In plane stress the storage's c_z S_r d(S_r p)/dp adds
+// c_z (S_r p)^2 / 2 (exactly: c_z = PoreCoupling::lateral_compliance, 0 but in plane stress). A
+// state function: the fluid energy balance (eqs 147-149) compares its change with the power the
+// update books step by step.
 KOKKOS_INLINE_FUNCTION double stored_energy_density(const VanGenuchten& vg, double phi,
-                                                    double inv_kw, double p) {
+                                                    double inv_kw, double p, double cz = 0) {
   if (p >= 0 || !vg.enabled)
-    return 0.5 * phi * inv_kw * p * p;
+    return 0.5 * (phi * inv_kw + cz) * p * p;
+  const double sp = vg.saturation(p) * p;
   const double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
                        0.9602898564975363};
   const double w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
@@ -109,7 +116,8 @@ KOKKOS_INLINE_FUNCTION double stored_energy_density(const VanGenuchten& vg, doub
       const double q = 0.5 * p * (1 + sign * x[k]);  // nodes on [p, 0]
       s += w[k] * phi * (vg.dsaturation_dp(q) + vg.saturation(q) * inv_kw) * q;
     }
-  return 0.5 * p * s;  // int_0^p f dq = (p/2) sum_k w_k f(q_k), q_k the nodes on [p, 0]
+  return 0.5 * p * s +
+         0.5 * cz * sp * sp;  // int_0^p f dq = (p/2) sum_k w_k f(q_k), nodes on [p, 0]
 }
 
 // The pressure at which the stored energy takes in a step's change of content C dp at a point,
@@ -129,15 +137,16 @@ KOKKOS_INLINE_FUNCTION bool storage_varies(const VanGenuchten& vg, double p0, do
   return vg.enabled && (p0 < 0 || p1 < 0);
 }
 KOKKOS_INLINE_FUNCTION double entry_pressure(const VanGenuchten& vg, double phi, double inv_kw,
-                                             double p0, double dp, double C) {
+                                             double p0, double dp, double C, double cz = 0) {
   if (!storage_varies(vg, p0, p0 + dp))
     return p0 + 0.5 * dp;
-  return entry_pressure(p0, dp, C, stored_energy_density(vg, phi, inv_kw, p0),
-                        stored_energy_density(vg, phi, inv_kw, p0 + dp), true);
+  return entry_pressure(p0, dp, C, stored_energy_density(vg, phi, inv_kw, p0, cz),
+                        stored_energy_density(vg, phi, inv_kw, p0 + dp, cz), true);
 }
 
-// Saturation (eq 12), relative permeability (eq 56), storage C and the undrained modulus
-// S_r / C (for the solid's undrained split, include/mupm/kernels/solid.hpp) of the owned points.
+// Saturation (eq 12), relative permeability (eq 56), storage C (with plane stress's c_z term,
+// header) and the undrained modulus biot S_r / C (for the solid's undrained split,
+// include/mupm/kernels/solid.hpp) of the owned points.
 template <int Dim>
 void fluid_constitutive(const Points<Dim>& pts, const FluidParams& prm, FluidState<Dim>& st) {
   auto p = pts.p, phi = pts.porosity, sr = pts.saturation, kr = pts.rel_perm;
@@ -147,14 +156,16 @@ void fluid_constitutive(const Points<Dim>& pts, const FluidParams& prm, FluidSta
   const VanGenuchten vg = prm.retention;
   const double inv_kw = 1.0 / prm.bulk_modulus;
   const bool split = !prm.semi_implicit;
+  const double biot = prm.pore.biot, cz = prm.pore.lateral_compliance;
   Kokkos::parallel_for(
       "mupm::Fluid::constitutive", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         const double s = vg.saturation(p(i));
         sr(i) = s;
         kr(i) = vg.relative_permeability(s);
-        const double c = phi(i) * (vg.dsaturation_dp(p(i)) + s * inv_kw);
+        const double ds = vg.dsaturation_dp(p(i));
+        const double c = phi(i) * (ds + s * inv_kw) + cz * s * (s + p(i) * ds);
         C(i) = c;
-        bu(i) = !split || (fixed(i) & kFixedPressure) || !(c > 0) ? 0.0 : s / c;
+        bu(i) = !split || (fixed(i) & kFixedPressure) || !(c > 0) ? 0.0 : biot * s / c;
       });
 }
 

@@ -18,16 +18,16 @@
 // conserved by the central-difference scheme.
 //
 // Pore pressure in the total stress (undrained split). With a fluid, pass 1 uses
-//   p* = p - (S_r / C) (tr eps - tr eps_ref),
+//   p* = p - (biot S_r / C) (tr eps - tr eps_ref)   (biot: PoreCoupling, 1 but in plane stress),
 // the pressure the point would have if no water had flowed since the last fluid update
-// (tr eps_ref; Points::undrained_modulus = S_r / C, zero where p is prescribed or without a
+// (tr eps_ref; Points::undrained_modulus = biot S_r / C, zero where p is prescribed or without a
 // fluid). The fluid update then starts from p* and adds the flow
 // (include/mupm/solvers/fluid_solver.hpp). Using p itself (held over the solid step, "drained
 // split") makes the pressure force lag the deformation by a step: with K_w/phi much larger than the
 // skeleton's modulus the central difference is then unconditionally unstable (the lagged stiffness
 // gives a characteristic root product 1 + (omega dt)^2 > 1). With p* the pore water is an undrained
-// stiffness S_r^2 / C of the current state, whose waves the stable-step estimate includes. (Kim,
-// Tchelepi & Juanes 2011 analyse the same splits for implicit coupling.)
+// stiffness (biot S_r)^2 / C of the current state, whose waves the stable-step estimate includes.
+// (Kim, Tchelepi & Juanes 2011 analyse the same splits for implicit coupling.)
 //
 // Kernels only: no MPI; the solver refreshes the ghosts between the passes
 // (include/mupm/solvers/solid_solver.hpp, solid_forces).
@@ -55,6 +55,7 @@ struct SolidParams {
   double stabilization = 0.5;  // G in [0, 1] (eqs 66-67)
   double stab_modulus = 0;     // D (eq 71 or the bulk-matched value), Pa/m^2
   double horizon_volume = 0;   // volume of a full continuous family (pi delta^2 h, 4/3 pi delta^3)
+  PoreCoupling pore;           // the pore pressure's coefficient (plane stress: biot < 1)
 };
 
 // What pass 2 does with the bond energy W (eq 34; include/mupm/kernels/fracture.hpp):
@@ -170,6 +171,7 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;  // G C1 |xi|^3
   const double c2 = prm.stabilization * prm.stab_modulus;         // G C2 |xi|
   const double inv_vh = 1.0 / prm.horizon_volume;
+  const double biot = prm.pore.biot;
   auto fixed = pts.fixed;
   Kokkos::parallel_for(
       "mupm::Solid::pass1", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
@@ -252,7 +254,7 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
             }
           }
         }
-        // Total stress sigma-bar - S_r p* 1 (eq 46) less the stabilization stress, times K^-1.
+        // Total stress sigma-bar - biot S_r p* 1 (eq 46) less the stabilization stress, times K^-1.
         double pe = p(i);
         if (bu(i) != 0) {
           double tr_eps = 0;
@@ -260,10 +262,11 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
             tr_eps += eps[d * Dim + d];
           pe -= bu(i) * (tr_eps - ref(i));  // undrained split (header)
         }
+        const double bsp = biot * sr(i) * pe;  // PoreCoupling: biot = 1 but in plane stress
         double S[Dim * Dim], Mm[R * Dim], p1[Dim * Dim], p2[R * Dim];
         for (int a = 0; a < Dim; ++a)
           for (int k = 0; k < Dim; ++k)
-            S[a * Dim + k] = sig[a * Dim + k] - (a == k ? sr(i) * pe : 0.0) - Q1[a * Dim + k];
+            S[a * Dim + k] = sig[a * Dim + k] - (a == k ? bsp : 0.0) - Q1[a * Dim + k];
         for (int k = 0; k < R * Dim; ++k)
           Mm[k] = m[k] - Q2[k];
         mat_mul<Dim, Dim>(S, Kinv, p1);
@@ -280,9 +283,9 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
         }
         if (effective)
           for (int k = 0; k < Dim * Dim; ++k)
-            P1w(i, k) = sr(i) * pe * Kinv[k];  // the pore-water part of P1, with opposite sign
+            P1w(i, k) = bsp * Kinv[k];  // the pore-water part of P1, with opposite sign
         if (eq17) {
-          const double dp = srf(i) > 0 ? sr(i) * pe - srf(i) * pf(i) : 0.0;  // eq 17
+          const double dp = srf(i) > 0 ? bsp - srf(i) * pf(i) : 0.0;  // eq 17
           for (int k = 0; k < Dim * Dim; ++k)
             P1f(i, k) = dp * Kinv[k];
         }

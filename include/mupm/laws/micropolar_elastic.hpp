@@ -9,6 +9,17 @@
 
 namespace mupm {
 
+// How the pore pressure p couples with the skeleton (Bishop's effective stress, eq 46, and the
+// mass balance, eq 117): the total stress sigma-bar - biot S_r p 1 and the water balance
+// C* dp/dt = -biot S_r d tr(eps)/dt - div + s, C* = C + lateral_compliance S_r d(S_r p)/dp.
+// biot = 1 and lateral_compliance = 0 in 3D and in plane strain. In plane stress (sigma_zz,total
+// = 0 with the pore water; derivation at MicropolarElastic::plane_stress_coupling) the thickness
+// follows the pressure: biot = 2 mu / (lambda + 2 mu) and lateral_compliance = 1 / (lambda + 2 mu).
+struct PoreCoupling {
+  double biot = 1;                // in-plane coefficient of S_r p
+  double lateral_compliance = 0;  // d eps_zz / d(S_r p) [1/Pa]
+};
+
 struct MicropolarElastic {
   static constexpr bool plastic = false;
   double lambda = 0;  // Lame constant [Pa]
@@ -31,6 +42,24 @@ struct MicropolarElastic {
   // plane-strain formulas into plane-stress ones), the J-integral's energy density.
   MicropolarElastic plane_stress() const {
     return {2 * lambda * mu / (lambda + 2 * mu), mu, mu_c, length};
+  }
+  // The pore water in plane stress, from this plane-stress law (lambda* = 2 lambda mu / (lambda +
+  // 2 mu)). With the total sigma_zz = lambda (tr eps + eps_zz) + 2 mu eps_zz - S_r p = 0 (tr over
+  // the plane), eps_zz = (S_r p - lambda tr eps) / (lambda + 2 mu), so
+  //   in-plane total stress  = eq 80 with lambda* - (2 mu / (lambda + 2 mu)) S_r p 1,
+  //   volume strain (3D)     = (2 mu / (lambda + 2 mu)) tr eps + S_r p / (lambda + 2 mu):
+  // the same coefficient biot = 2 mu / (lambda + 2 mu) = 1 - lambda* / (2 mu) in the force and in
+  // the mass balance (the coupling stays symmetric, so the energy balance still closes), and the
+  // water's storage gains S_r d(S_r p)/dp / (lambda + 2 mu), 1 / (lambda + 2 mu) = biot / (2 mu):
+  // the thickness swells with the pressure. Its energy (S_r p)^2 / (2 (lambda + 2 mu)) is the
+  // eps_zz part of the skeleton's strain energy, booked with the water's stored energy
+  // (include/mupm/kernels/fluid.hpp). Checks: saturated, incompressible water and grains under an
+  // in-plane all-round pressure q take p = 2q/3 (not q), and the one-dimensional consolidation
+  // modulus becomes lambda* + 2 mu with storage phi/K_w + 1/(lambda + mu)
+  // (tests/solvers/test_fluid_solver.cpp, the plane-stress entries).
+  PoreCoupling plane_stress_coupling() const {
+    const double biot = 1 - lambda / (2 * mu);
+    return {biot, biot / (2 * mu)};
   }
   double young() const { return mu * (3 * lambda + 2 * mu) / (lambda + mu); }
   double poisson() const { return lambda / (2 * (lambda + mu)); }

@@ -275,9 +275,10 @@ class FluidSolver : public Module {
       auto pw = p.p, phi = p.porosity, sr = p.saturation, m = p.fluid_content;
       auto vs = p.vol_strain, ref = p.vol_strain_ref;
       const double inv_kw = 1.0 / prm_.bulk_modulus;
+      const double cz = prm_.pore.lateral_compliance;
       Kokkos::parallel_for(
           "mupm::Fluid::content", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-            m(i) = phi(i) * sr(i) * (1 + pw(i) * inv_kw);
+            m(i) = phi(i) * sr(i) * (1 + pw(i) * inv_kw) + cz * sr(i) * sr(i) * pw(i);
             ref(i) = vs(i);
           });
       mass0_ = fluid_mass();
@@ -385,22 +386,24 @@ class FluidSolver : public Module {
     auto C = c_old_, sr = sr_old_, f0 = flow_old_, hdp = hdp_, ddp = dp_, src = source_;
     const VanGenuchten vg = prm_.retention;
     const double inv_kw = 1.0 / prm_.bulk_modulus;
+    const double biot = prm_.pore.biot, cz = prm_.pore.lateral_compliance;
     double w[3] = {0, 0, 0};
     Kokkos::parallel_reduce(
         "mupm::Fluid::book_projection", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& wc, double& wd, double& we) {
           const double dv = vs(i) - ref(i), dp = ddp(i), p0 = pw(i) - dp;
           const double flow = f0(i) + hdp(i) / vol(i);  // div(p_n) + H dp: backward Euler's
-          const double rhs = -sr(i) * dv + dt * (src(i) - flow);
+          const double rhs = -biot * sr(i) * dv + dt * (src(i) - flow);
           const bool held = fixed(i) & kFixedPressure;
           target(i) = held ? vol(i) * (C(i) * dp - rhs) : 0.0;  // the reservoir's water [m^3]
           const double pm = p0 + 0.5 * dp;
-          const double pe = src(i) != 0 || held ? entry_pressure(vg, phi(i), inv_kw, p0, dp, C(i))
-                                                : p0 + 0.5 * dp;
-          wc += vol(i) * pm * sr(i) * dv;
+          const double pe = src(i) != 0 || held
+                                ? entry_pressure(vg, phi(i), inv_kw, p0, dp, C(i), cz)
+                                : p0 + 0.5 * dp;
+          wc += vol(i) * pm * biot * sr(i) * dv;
           wd += vol(i) * pm * dt * flow;
           we += vol(i) * pe * dt * src(i) + pe * target(i);
-          m(i) += C(i) * dp + sr(i) * dv;
+          m(i) += C(i) * dp + biot * sr(i) * dv;
         },
         w[0], w[1], w[2]);
     book(target, w);
@@ -436,13 +439,14 @@ class FluidSolver : public Module {
     auto pw = p.p, phi = p.porosity, vol = p.volume;
     const VanGenuchten vg = prm_.retention;
     const double inv_kw = 1.0 / prm_.bulk_modulus;
+    const double cz = prm_.pore.lateral_compliance;
     auto psi = psi_;
     const bool cached = psi_valid_;
     double s = 0;
     Kokkos::parallel_reduce(
         "mupm::Fluid::stored_energy", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& acc) {
-          acc += vol(i) * (cached ? psi(i) : stored_energy_density(vg, phi(i), inv_kw, pw(i)));
+          acc += vol(i) * (cached ? psi(i) : stored_energy_density(vg, phi(i), inv_kw, pw(i), cz));
         },
         s);
     MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
@@ -462,17 +466,19 @@ class FluidSolver : public Module {
     return m;
   }
 
-  // Largest S_r^2 / C over the points: the pore water's contribution to the undrained bulk
-  // modulus (K_w / phi when saturated), for the solid's stable step.
+  // Largest (biot S_r)^2 / C over the points: the pore water's contribution to the undrained bulk
+  // modulus (K_w / phi when saturated in plane strain and 3D), for the solid's stable step.
   double undrained_stiffening() const {
     const auto& p = disc_.points;
     auto sr = p.saturation;
     auto C = st_.storage;
+    const double biot = prm_.pore.biot;
     double m = 0;
     Kokkos::parallel_reduce(
         "mupm::Fluid::undrained", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& acc) {
-          const double v = C(i) > 0 ? sr(i) * sr(i) / C(i) : 0.0;
+          const double bs = biot * sr(i);
+          const double v = C(i) > 0 ? bs * bs / C(i) : 0.0;
           acc = v > acc ? v : acc;
         },
         Kokkos::Max<double>(m));
@@ -714,6 +720,7 @@ class FluidSolver : public Module {
     auto phi = p.porosity;
     const VanGenuchten vg = prm_.retention;
     const double inv_kw = 1.0 / prm_.bulk_modulus;
+    const double biot = prm_.pore.biot, cz = prm_.pore.lateral_compliance;
     const double inv_total = 1.0 / dt_total;
     if (fracture_) {
       // The bulk's explicit step without the exchange (p^ of fracture_flow.hpp), then the
@@ -724,7 +731,7 @@ class FluidSolver : public Module {
       Kokkos::parallel_for(
           "mupm::Fluid::predictor", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
             const double dv = (vs(i) - ref(i)) * inv_total * dt;
-            const double rhs = -sr(i) * dv + dt * (src(i) - flow(i));
+            const double rhs = -biot * sr(i) * dv + dt * (src(i) - flow(i));
             phat(i) =
                 (fixed(i) & kFixedPressure) ? target(i) : pw(i) + (C(i) > 0 ? rhs / C(i) : 0.0);
           });
@@ -750,7 +757,7 @@ class FluidSolver : public Module {
             if (any_mirrored && (mirrored(i) != 0) != (phase == 1))
               return;
             const double dv = (vs(i) - ref(i)) * inv_total * dt;  // eq 117 over this step
-            const double rhs = -sr(i) * dv + dt * (src(i) - flow(i));
+            const double rhs = -biot * sr(i) * dv + dt * (src(i) - flow(i));
             double dp;
             const double p0 = pw(i);
             if (fixed(i) & kFixedPressure) {
@@ -764,16 +771,17 @@ class FluidSolver : public Module {
             // the step's mean pressure p0 + dp/2 when C is constant (header). psi(p0) is the
             // last update's psi(p1) (psi_, which stored_energy() sums).
             const double p1 = p0 + dp;
-            const double psi1 = stored_energy_density(vg, phi(i), inv_kw, p1);
+            const double psi1 = stored_energy_density(vg, phi(i), inv_kw, p1, cz);
             const bool varies = storage_varies(vg, p0, p1);
             const double psi0 =
-                varies ? (cached ? psi(i) : stored_energy_density(vg, phi(i), inv_kw, p0)) : 0.0;
+                varies ? (cached ? psi(i) : stored_energy_density(vg, phi(i), inv_kw, p0, cz))
+                       : 0.0;
             psi(i) = psi1;
             const double pe = entry_pressure(p0, dp, C(i), psi0, psi1, varies);
-            wc += vol(i) * pe * sr(i) * dv;
+            wc += vol(i) * pe * biot * sr(i) * dv;
             wd += vol(i) * pe * dt * flow(i);
             we += vol(i) * pe * dt * src(i) + pe * target(i);
-            m(i) += C(i) * dp + sr(i) * dv;
+            m(i) += C(i) * dp + biot * sr(i) * dv;
             rate(i) = dp / dt;
             pw(i) = p1;  // eq 145, beta_3 = 0
           },

@@ -493,7 +493,7 @@ class PressureProjection {
     Kokkos::deep_copy(alpha, st.alpha);
     add_pressure_stabilization(disc_, prm, dt, sk.density, alpha);
     flow_ = assemble_flow_operator(disc_, prm, alpha);
-    coupling_ = assemble_volume_coupling(disc_);
+    coupling_ = assemble_volume_coupling(disc_, prm.pore.biot);
     std::vector<std::pair<GlobalId, std::vector<std::pair<GlobalId, double>>>> extra;
     for (std::size_t k = 0; k < m; ++k)
       extra.push_back({offset_ + p.gid(crack.point[k]), crack.coupling[k]});

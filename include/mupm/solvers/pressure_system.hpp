@@ -17,7 +17,8 @@
 //    Gr the gradient (Dim rows per point), L the graph Laplacian of the bond weights
 //    V_i V_j (alpha_i + alpha_j): symmetric, and positive semi-definite (the form above is a
 //    sum of squares). Points with a singular K have g = 0 and keep their alpha.
-// 2. The coupling B~ = diag(V S_r) B, B_i = d(tr eps_i)/d(u, theta) the Jacobian of the
+// 2. The coupling B~ = diag(V biot S_r) B (biot: PoreCoupling, 1 but in plane stress), B_i = d(tr
+// eps_i)/d(u, theta) the Jacobian of the
 //    nonlocal volumetric strain (eqs 50, 117): tr eps_i = sum_j V_j U^_ij . c_ij, c_ij = K_i^-1
 //    xi_ij, U^ = u_j - u_i - (theta_i + theta_j)/2 x xi (eqs 2-9), so
 //      d/du_j = V_j c_ij,  d/du_i = -sum_j V_j c_ij,  d/dtheta_i += d/dtheta_j = -V_j (xi x c)/2.
@@ -165,14 +166,15 @@ Teuchos::RCP<CrsMatrix> assemble_flow_operator(const Discretization<Dim>& disc,
 }
 
 // The pressure stabilization of the semi-implicit step (derivation in pressure_projection.hpp):
-// alpha_i += G_p S_r,i^2 dt / (rho_i k2 w0_i) on the owned points, w0_i = omega_0,i / V_H (eq 76),
-// rho the lumped mass density; then the ghosts are refreshed (collective).
+// alpha_i += G_p (biot S_r,i)^2 dt / (rho_i k2 w0_i) on the owned points, w0_i = omega_0,i / V_H
+// (eq 76), rho the lumped mass density; then the ghosts are refreshed (collective).
 template <int Dim>
 void add_pressure_stabilization(Discretization<Dim>& disc, const FluidParams& prm, double dt,
                                 const Scalars& density, const Scalars& alpha) {
   const auto& p = disc.points;
   for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const double w0 = disc.shape.family_volume(i) / prm.horizon_volume, s = p.saturation(i);
+    const double w0 = disc.shape.family_volume(i) / prm.horizon_volume,
+                 s = prm.pore.biot * p.saturation(i);
     const double rho = density(i);
     if (w0 > 0 && rho > 0)
       alpha(i) += prm.projection_stabilization * s * s * dt / (rho * prm.second_moment * w0);
@@ -183,7 +185,7 @@ void add_pressure_stabilization(Discretization<Dim>& disc, const FluidParams& pr
 // B~ (header, 2), over the owned points (rows) and their (u, theta) components (columns:
 // component_map(disc, Dim + R, ...)).
 template <int Dim>
-Teuchos::RCP<CrsMatrix> assemble_volume_coupling(const Discretization<Dim>& disc) {
+Teuchos::RCP<CrsMatrix> assemble_volume_coupling(const Discretization<Dim>& disc, double biot = 1) {
   constexpr int R = kRotDim<Dim>, NC = Dim + R;
   const auto& p = disc.points;
   const auto& b = disc.bonds;
@@ -194,7 +196,7 @@ Teuchos::RCP<CrsMatrix> assemble_volume_coupling(const Discretization<Dim>& disc
   for (std::size_t i = 0; i < n; ++i) {
     if (sh.singular(i) || (p.fixed(i) & kFixedNoEnergy))
       continue;
-    const double s = p.volume(i) * p.saturation(i);
+    const double s = p.volume(i) * biot * p.saturation(i);
     double Kinv[Dim * Dim];
     for (int k = 0; k < Dim * Dim; ++k)
       Kinv[k] = sh.Kinv(i, k);

@@ -592,8 +592,8 @@ class SolidSolver : public Mechanics, public Skeleton {
   // the largest eigenvalue of M^-1 K of the discrete operator (prescribed components held),
   // by power iteration with the mass-weighted Rayleigh quotient (it approaches omega_max^2
   // from below). The state is restored afterwards.
-  // With a fluid the operator includes the undrained stiffness S_r^2 / C of the undrained split
-  // (include/mupm/kernels/solid.hpp): the fastest waves are the undrained ones.
+  // With a fluid the operator includes the undrained stiffness (biot S_r)^2 / C of the undrained
+  // split (include/mupm/kernels/solid.hpp): the fastest waves are the undrained ones.
   bool limits_time_step() const override { return true; }
   double stable_time_step() override { return estimate_stable_dt(); }
   std::string describe() const override {
