@@ -224,8 +224,9 @@ RCP<ParameterList> valid_parameters() {
           "law's in-plane lambda becomes 2 lambda mu / (lambda + 2 mu); derivation in "
           "include/mupm/laws/micropolar_elastic.hpp; with pore water the total sigma_zz = 0: the "
           "pressure's in-plane coefficient becomes 2 mu / (lambda + 2 mu) and the storage gains "
-          "1 / (lambda + 2 mu)), for Solver->Physics = Micropolar Solid or Hydro-Mechanical with "
-          "Materials->Model = Micropolar Elastic (not yet with plasticity or Fracture Flow).",
+          "1 / (lambda + 2 mu); Drucker-Prager returns to sigma_zz = 0, derivation in "
+          "include/mupm/laws/micropolar_drucker_prager.hpp), for Solver->Physics = Micropolar "
+          "Solid or Hydro-Mechanical (not yet with Fracture->Fracture Flow).",
           plane_options().validator());
     d.set("Boundary Layer Horizons", 2.0,
           "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
@@ -1047,7 +1048,6 @@ void check_dimension_arrays(ParameterList& input) {
                        " (the pores hold the water).");
   }
   const ParameterList& disc = input.sublist("Discretization");
-  const ParameterList& materials = input.sublist("Materials");
   if (plane_options()(disc.get<std::string>("Plane")) == Plane::Stress) {
     if (dim != 2)
       throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is for Dimension = 2.");
@@ -1060,12 +1060,6 @@ void check_dimension_arrays(ParameterList& input) {
                        path_of(input.sublist("Fracture"), "Fracture Flow") +
                        " = true (the crack water's coupling with the plate's thickness is not "
                        "derived): use Plane = Strain.");
-    if (constitutive_model_options()(materials.get<std::string>("Model")) !=
-        ConstitutiveModel::MicropolarElastic)
-      throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +
-                       path_of(materials, "Model") + " = " + materials.get<std::string>("Model") +
-                       " (its return mapping keeps sigma_zz): "
-                       "use Plane = Strain.");
   }
   if (has_solid(phys)) {
     const ParameterList& m = input.sublist("Materials");

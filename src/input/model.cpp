@@ -393,6 +393,8 @@ Model<Dim> model_from_input(const ParameterList& input) {
   const bool plane_stress =
       Dim == 2 &&
       plane_options()(input.sublist("Discretization").get<std::string>("Plane")) == Plane::Stress;
+  m.material = law;
+  m.plane_stress = plane_stress;
   if (plane_stress)
     law = law.plane_stress();
   m.solid = solid_params<Dim>(

@@ -331,7 +331,8 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
       case ConstitutiveModel::MicropolarDruckerPrager:
         attach(std::make_unique<SolidSolver<Dim, MicropolarDruckerPrager<Dim>>>(
             disc, model.solid, model.boundary_conditions, settings, mpi,
-            MicropolarDruckerPrager<Dim>(model.solid.law, model.plasticity, disc.points)));
+            MicropolarDruckerPrager<Dim>(model.material, model.plasticity, disc.points,
+                                         model.plane_stress)));
         break;
     }
   } else if (physics == Physics::KinematicsOnly) {

@@ -285,8 +285,8 @@ TEST(Input, SolidAndBoundaryConditions) {
 // (K = 1e8, mu = 5e7: lambda = 6.667e7, lambda* = 3.333e7); Strain keeps lambda. With pore water
 // the pressure's coefficient is 2 mu / (lambda + 2 mu) = 0.6 and the storage gains
 // 1 / (lambda + 2 mu) = 6e-9 / Pa in both the solid's and the fluid's parameters (1 and 0 in plane
-// strain). Plane stress is refused in 3D, without a skeleton, with Fracture Flow and with
-// Drucker-Prager, naming the parameters.
+// strain). Plane stress is refused in 3D, without a skeleton and with Fracture Flow, naming the
+// parameters.
 TEST(Input, PlaneStress) {
   const std::string stress = "<Parameter name=\"Plane\" type=\"string\" value=\"Stress\"/>";
   const double lambda = 1e8 - 2 * 5e7 / 3.0, mu = 5e7;
@@ -332,16 +332,21 @@ TEST(Input, PlaneStress) {
                                 "<ParameterList name=\"Fracture\"><Parameter name=\"Fracture "
                                 "Flow\" type=\"bool\" value=\"true\"/></ParameterList>")),
       {"mupm->Discretization->Plane = Stress", "mupm->Fracture->Fracture Flow = true"});
-  expect_error(xml(kOk + stress,
-                   "<ParameterList name=\"Materials\">"
-                   "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
-                   "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
-                   "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
-                   "<Parameter name=\"Model\" type=\"string\" value=\"Micropolar Drucker-Prager\"/>"
-                   "<Parameter name=\"Cohesion\" type=\"double\" value=\"1e4\"/>"
-                   "</ParameterList>"),
-               {"mupm->Discretization->Plane = Stress",
-                "mupm->Materials->Model = Micropolar Drucker-Prager"});
+  // Drucker-Prager keeps the 3D law for its return (Model::material) and is told the plane.
+  auto dp = parse_input(xml(kOk + stress,
+                            "<ParameterList name=\"Materials\">"
+                            "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+                            "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+                            "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+                            "<Parameter name=\"Model\" type=\"string\" "
+                            "value=\"Micropolar Drucker-Prager\"/>"
+                            "<Parameter name=\"Cohesion\" type=\"double\" value=\"1e4\"/>"
+                            "</ParameterList>"));
+  validate_input(*dp);
+  const auto m = model_from_input<2>(*dp);
+  EXPECT_TRUE(m.plane_stress);
+  EXPECT_DOUBLE_EQ(m.material.lambda, lambda);
+  EXPECT_DOUBLE_EQ(m.solid.law.lambda, 2 * lambda * mu / (lambda + 2 * mu));
 }
 
 TEST(Input, MalformedXml) {

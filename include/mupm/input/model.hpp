@@ -81,6 +81,8 @@ struct Model {
   RunSettings run;
   ConstitutiveModel constitutive_model = ConstitutiveModel::MicropolarElastic;
   SolidParams solid;
+  MicropolarElastic material;      // the 3D law (solid.law is its plane_stress() in plane stress)
+  bool plane_stress = false;       // Discretization->Plane = Stress (2D)
   DruckerPragerParams plasticity;  // Materials->Model = Micropolar Drucker-Prager
   double solid_density = 2000;     // rho_s
   double damping = 0;              // Solver->Damping

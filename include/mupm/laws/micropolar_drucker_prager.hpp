@@ -24,6 +24,16 @@
 //
 // Plane strain (2D): eps_zz = 0, and the state keeps eps^p_zz: sigma_zz = lambda tr(eps^e) +
 // 2 mu eps^e_zz with eps^e_zz = -eps^p_zz, and p-bar, s, q are those of the 3x3 stress.
+// Plane stress (2D, Discretization->Plane = Stress): sigma_zz = 0 with eps_zz free. The return
+// is the same 3D return with the total eps_zz as a parameter, eps^e_zz = eps_zz - eps^p_zz, and
+// eps_zz is the root of sigma_zz(eps_zz) = 0 (drucker_prager_return_plane_stress): it starts
+// from the elastic plane-stress value eps^p_zz - lambda tr(eps^e) / (lambda + 2 mu) (exact where
+// the point stays elastic), then secant steps, bisection once the root is bracketed. The
+// slope d sigma_zz / d eps_zz is at most the elastic lambda + 2 mu, so a first step -sigma_zz /
+// (lambda + 2 mu) never passes the root. The state keeps eps^p_zz as in plane strain; eps_zz
+// itself follows from the strain and the state, so it is not kept. q, p-bar and the flow are
+// the 3D ones: the yield stress under in-plane uniaxial stress is the 3D one,
+// k c / (1 + a1 / sqrt3) in tension (tests/kernels/test_plasticity.cpp).
 //
 // Return mapping (backward Euler, closest point in the energy norm). With x = d lambda and the
 // trial state (s_t, m_t, p_t) of the elastic predictor:
@@ -136,12 +146,13 @@ KOKKOS_INLINE_FUNCTION double q_of(double qs, double qm, double mu, double x, do
 // are the total nonlocal strain and wryness (eqs 50-51); `old` the state at the start of the
 // step. Writes the new state, sigma-bar (Dim x Dim), its zz component (*szz, plane strain; the
 // 3D trace is in sigma) and m; returns the stored (elastic) energy density
-// 1/2 (sigma : eps^e + m : kappa^e).
+// 1/2 (sigma : eps^e + m : kappa^e). `ezz` (2D, with `given_ezz`): the total eps_zz (plane
+// stress's iterate); otherwise 0 (plane strain).
 template <int Dim>
 KOKKOS_INLINE_FUNCTION double drucker_prager_return(
     const MicropolarElastic& el, const DruckerPragerParams& dp, const double* eps,
     const double* kappa, const PlasticPoint<Dim>& old, PlasticPoint<Dim>& nw, double* sigma,
-    double* szz, double* m, ReturnInfo* info = nullptr) {
+    double* szz, double* m, ReturnInfo* info = nullptr, bool given_ezz = false, double ezz = 0) {
   constexpr int R = kRotDim<Dim>;
   const double mu = el.mu, mc = el.mu_c, lam = el.lambda, K = lam + 2 * mu / 3;
   const double B = el.couple_modulus(), l2 = el.length * el.length;
@@ -151,7 +162,7 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return(
     for (int b = 0; b < Dim; ++b)
       ee[a][b] = eps[a * Dim + b] - old.ep[a * Dim + b];
   if (Dim == 2)
-    ee[2][2] = -old.ezz;
+    ee[2][2] = given_ezz ? ezz - old.ezz : -old.ezz;
   const double tr = ee[0][0] + ee[1][1] + ee[2][2];
   double st[3][3];  // trial stress (eq 80)
   for (int a = 0; a < 3; ++a)
@@ -273,6 +284,52 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return(
   return w;
 }
 
+// Plane stress (header): the return of drucker_prager_return<2> with the total eps_zz that makes
+// sigma_zz = 0, to |sigma_zz| <= 1e-12 of the stress's scale (the largest of |sigma|, |m| / l
+// and k c0). `el` is the 3D law (not its plane_stress()). *szz is the residual sigma_zz.
+KOKKOS_INLINE_FUNCTION double drucker_prager_return_plane_stress(
+    const MicropolarElastic& el, const DruckerPragerParams& dp, const double* eps,
+    const double* kappa, const PlasticPoint<2>& old, PlasticPoint<2>& nw, double* sigma,
+    double* szz, double* m, ReturnInfo* info = nullptr) {
+  const double stiff = el.lambda + 2 * el.mu;  // the elastic d sigma_zz / d eps_zz, an upper bound
+  const double tr = eps[0] - old.ep[0] + eps[3] - old.ep[3];
+  double e = old.ezz - el.lambda * tr / stiff;  // the elastic plane-stress eps_zz
+  double w = drucker_prager_return<2>(el, dp, eps, kappa, old, nw, sigma, szz, m, info, true, e);
+  double scale = dp.k() * (dp.cohesion > dp.residual ? dp.cohesion : dp.residual);
+  for (int k = 0; k < 4; ++k)
+    scale = std::fabs(sigma[k]) > scale ? std::fabs(sigma[k]) : scale;
+  const double l = el.length > 0 ? el.length : 1.0;
+  for (int k = 0; k < 2; ++k)
+    scale = std::fabs(m[k]) / l > scale ? std::fabs(m[k]) / l : scale;
+  const double tol = 1e-12 * scale;
+  double g = *szz, e_prev = e, g_prev = g;
+  bool have_lo = false, have_hi = false;  // bracket: sigma_zz(lo) < 0 < sigma_zz(hi)
+  double lo = 0, hi = 0;
+  for (int it = 0; it < 100 && std::fabs(g) > tol; ++it) {
+    if (g < 0) {
+      lo = e;
+      have_lo = true;
+    } else {
+      hi = e;
+      have_hi = true;
+    }
+    double next = e - g / stiff;  // the first step, and where the secant is not increasing
+    if (it > 0 && e != e_prev) {
+      const double slope = (g - g_prev) / (e - e_prev);
+      if (slope > 0)
+        next = e - g / slope;
+    }
+    if (have_lo && have_hi && !(next > lo && next < hi))
+      next = 0.5 * (lo + hi);
+    e_prev = e;
+    g_prev = g;
+    e = next;
+    w = drucker_prager_return<2>(el, dp, eps, kappa, old, nw, sigma, szz, m, info, true, e);
+    g = *szz;
+  }
+  return w;
+}
+
 // The law of pass 1 (the Law of include/mupm/kernels/solid.hpp) with the points' plastic state
 // (include/mupm/data/points.hpp). Two states: the one at the start of the step (packed in
 // Points::plastic_step_start, with the stress the step starts from) and the current one
@@ -293,8 +350,9 @@ struct MicropolarDruckerPrager {
                        kSig = kEq + 1, kSzz = kSig + Dim * Dim, kM = kSzz + 1,
                        kStartWidth = kM + R * Dim;
 
-  MicropolarElastic elastic;
+  MicropolarElastic elastic;  // the 3D law (in plane stress too: the return is 3D)
   DruckerPragerParams dp;
+  bool plane_stress = false;       // 2D, Discretization->Plane = Stress
   Vectors start;                   // Points::plastic_step_start
   Vectors ep, kp;                  // current eps^p, kappa^p
   Scalars ezz, eq, vol, coh, szz;  // eps^p_zz, eps-hat^p, tr eps^p, c, sigma_zz
@@ -302,9 +360,10 @@ struct MicropolarDruckerPrager {
   MicropolarDruckerPrager() = default;
   template <class Points>
   MicropolarDruckerPrager(const MicropolarElastic& el, const DruckerPragerParams& d,
-                          const Points& p)
+                          const Points& p, bool plane = false)
       : elastic(el),
         dp(d),
+        plane_stress(Dim == 2 && plane),
         start(p.plastic_step_start),
         ep(p.plastic_strain),
         kp(p.plastic_wryness),
@@ -327,7 +386,13 @@ struct MicropolarDruckerPrager {
       old.kp[k] = start(i, kKp + k);
     old.eq = start(i, kEq);
     double sz = 0;
-    const double w = drucker_prager_return<Dim>(elastic, dp, eps, kappa, old, nw, sigma, &sz, m);
+    double w;
+    if constexpr (Dim == 2)
+      w = plane_stress
+              ? drucker_prager_return_plane_stress(elastic, dp, eps, kappa, old, nw, sigma, &sz, m)
+              : drucker_prager_return<Dim>(elastic, dp, eps, kappa, old, nw, sigma, &sz, m);
+    else
+      w = drucker_prager_return<Dim>(elastic, dp, eps, kappa, old, nw, sigma, &sz, m);
     double tr = Dim == 2 ? nw.ezz : 0.0;
     for (int k = 0; k < Dim * Dim; ++k)
       ep(i, k) = nw.ep[k];
