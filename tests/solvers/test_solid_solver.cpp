@@ -26,7 +26,7 @@ const MicropolarElastic kLaw =
 // at x = 0 and loaded at x = L as `load` says, run to rest. Returns the owned points' x and u
 // (gathered on every rank, sorted by gid) and the reaction of the first condition.
 struct BarResult {
-  std::vector<double> x, u;
+  std::vector<double> x, u, y, v;  // x, u_x; y, u_y
   double reaction = 0;
 };
 template <int Dim>
@@ -52,14 +52,16 @@ BarResult bar_to_rest(const GridSpec<Dim>& g, std::vector<BoundaryCondition> bcs
   auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.gid);
   const std::size_t total = std::size_t(disc.grid.n_global());
   BarResult r;
-  r.x.assign(total, 0.0);
-  r.u.assign(total, 0.0);
+  for (auto* v : {&r.x, &r.u, &r.y, &r.v})
+    v->assign(total, 0.0);
   for (std::size_t i = 0; i < disc.points.n_owned; ++i) {
     r.x[gid(i)] = x(i, 0);
     r.u[gid(i)] = u(i, 0);
+    r.y[gid(i)] = x(i, 1);
+    r.v[gid(i)] = u(i, 1);
   }
-  MPI_Allreduce(MPI_IN_PLACE, r.x.data(), int(total), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  MPI_Allreduce(MPI_IN_PLACE, r.u.data(), int(total), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  for (auto* v : {&r.x, &r.u, &r.y, &r.v})
+    MPI_Allreduce(MPI_IN_PLACE, v->data(), int(total), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   r.reaction = solver.reactions().at(0);
   return r;
 }
@@ -186,6 +188,44 @@ TEST(SolidSolverLong, BarUnderTraction) {
       }
     }
   }
+}
+
+// Plane stress (Discretization->Plane = Stress: the law's plane_stress()): the bar of
+// BarUnderTraction (consistent traction, delta = 3.015 dx) relaxes to uniaxial stress, axial strain
+// t / E and lateral strain -nu t / E with the 3D E and nu, measured between the columns at 10.5
+// and 30.5 dx and between the top and bottom rows there. Plane strain would give t (1 - nu^2) / E
+// and -nu (1 + nu) t / E: 3.2 % and 18 % away (nu = 0.18).
+TEST(SolidSolver, BarUnderTractionPlaneStress) {
+  const double dx = 2.5e-3, t = 1e5, L = 40 * dx, H = 8 * dx;
+  const auto b = traction_bar(dx, 3.015, t, true);
+  const auto r = bar_to_rest(b.g, {b.hold, b.pull}, 6000, kLaw.plane_stress());
+  const double E = kLaw.young(), nu = kLaw.poisson();  // 3D
+  double axial = 0;
+  loaded_face_excess(r, dx, 10.5 * dx, 30.5 * dx, L - 0.5 * dx, axial);
+  // u_y of the top row less the bottom row's, over the body's columns 10.5 .. 30.5 dx.
+  double top = 0, bottom = 0;
+  int n_top = 0, n_bottom = 0;
+  for (std::size_t k = 0; k < r.x.size(); ++k) {
+    if (r.x[k] < 10 * dx || r.x[k] > 31 * dx)
+      continue;
+    if (std::abs(r.y[k] - (H - 0.5 * dx)) < 0.1 * dx) {
+      top += r.v[k];
+      ++n_top;
+    } else if (std::abs(r.y[k] - 0.5 * dx) < 0.1 * dx) {
+      bottom += r.v[k];
+      ++n_bottom;
+    }
+  }
+  ASSERT_GT(n_top, 0);
+  ASSERT_GT(n_bottom, 0);
+  const double lateral = (top / n_top - bottom / n_bottom) / (H - dx);
+  std::printf(
+      "[ plane stress bar ] axial strain / (t/E) = %.5f, lateral strain / (-nu t/E) = %.5f "
+      "(plane strain would give %.5f and %.5f)\n",
+      axial / (t / E), lateral / (-nu * t / E), 1 - nu * nu, 1 + nu);
+  EXPECT_NEAR(axial / (t / E), 1.0, 0.005);
+  EXPECT_NEAR(lateral / (-nu * t / E), 1.0, 0.005);
+  EXPECT_NEAR(r.reaction, -t * H * b.g.thickness, 1e-4 * t * H) << "reaction";
 }
 
 // The same in 3D (a 16 x 3 x 3 bar, uniaxial stress: strain t / E): the consistent

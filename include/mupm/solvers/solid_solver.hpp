@@ -859,7 +859,7 @@ class SolidSolver : public Mechanics, public Skeleton {
         });
   }
 
-  // sum_i V_i S_r (p*_old + p*_new)/2 (tr eps_new - tr eps_old) of this step (this rank's
+  // sum_i V_i biot S_r (p*_old + p*_new)/2 (tr eps_new - tr eps_old) of this step (this rank's
   // points; step() sums over ranks), with the p* the forces were evaluated with: the old one
   // is from before any fluid update in between, as the first half of the velocity update
   // used it (trapezoid rule on the applied forces, like the external work).
@@ -868,11 +868,12 @@ class SolidSolver : public Mechanics, public Skeleton {
     auto vs = p.vol_strain, sr = p.saturation, vol = p.volume;
     auto ps = st_.pstar, ps_old = p.solid_pressure;
     auto old = vs_old_;
+    const double biot = prm_.pore.biot;  // PoreCoupling: 1 but in plane stress
     double w = 0;
     Kokkos::parallel_reduce(
         "mupm::Solid::pore_work", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& acc) {
-          acc += vol(i) * sr(i) * 0.5 * (ps(i) + ps_old(i)) * (vs(i) - old(i));
+          acc += vol(i) * biot * sr(i) * 0.5 * (ps(i) + ps_old(i)) * (vs(i) - old(i));
         },
         w);
     return w;
