@@ -518,6 +518,10 @@ FixedSettings fixed_settings(const ParameterList& input) {
     fix("Fracture", "Bond Breakage",
         "each criterion keeps its own state (bond energies, the crack's tip), which the other "
         "has not accumulated");
+    fix("Discretization", "Plane",
+        "the checkpoint's stresses, plastic strains and water content are that plane's (plane "
+        "stress: sigma_zz = 0 with eps_zz free); the other plane would start from them with a "
+        "jump in the stored energy");
   }
   const ParameterList& d = input.sublist("Discretization");
   f.push_back({"Discretization->Pre-Cracks", cracks_text(d.sublist("Pre-Cracks")),

@@ -53,7 +53,8 @@ expect_dir folder_below_file_validate "afile' is a file, not a folder" --validat
 # refused by name, by the run and by --validate (each once ran with exit 0: a Drucker-Prager
 # checkpoint went on elastic with its internal energy doubled; an added pre-crack only flagged
 # points; Fracture Flow switched off lost the crack water; a smaller Minimum Aperture kept the
-# checkpoint's stable step and diverged).
+# checkpoint's stable step and diverged; a switch to plane stress went on from plane strain's
+# stresses).
 restart_with() {  # restart_with CHECKPOINT_FOLDER: Restart From its checkpoint, folder NAME.again
   sed -e "s|<Parameter name=\"Number of Steps\" type=\"int\" value=\"2\"/>|<Parameter name=\"Number of Steps\" type=\"int\" value=\"4\"/><Parameter name=\"Restart From\" type=\"string\" value=\"$1/checkpoint.h5\"/>|" \
     -e "s|name=\"Folder\" type=\"string\" value=\"$1\"|name=\"Folder\" type=\"string\" value=\"$1.again\"|"
@@ -71,6 +72,10 @@ expect elastic_to_dp 2 'was written with mupm->Materials->Model = Micropolar Ela
 restart_with plain <plain.xml |
   sed 's|<Parameter name="Counts" type="Array(int)" value="{20, 10}"/>|&<ParameterList name="Pre-Cracks"><ParameterList name="c"><Parameter name="Start" type="Array(double)" value="{-0.01, 0.05}"/><Parameter name="End" type="Array(double)" value="{0.1, 0.05}"/></ParameterList></ParameterList>|' >added_crack.xml
 expect added_crack 2 'was written with mupm->Discretization->Pre-Cracks = none, and this input has c: Start = {-0.01, 0.05} End = {0.1, 0.05}'
+restart_with plain <plain.xml |
+  sed 's|<Parameter name="Counts" type="Array(int)" value="{20, 10}"/>|&<Parameter name="Plane" type="string" value="Stress"/>|' >to_plane_stress.xml
+grep -q 'value="Stress"' to_plane_stress.xml || fail "to_plane_stress.xml not derived"
+expect to_plane_stress 2 'was written with mupm->Discretization->Plane = Strain, and this input has Stress'
 # A pre-crack that misses the body (it cut nothing and measured no length).
 base '<ParameterList name="Pre-Cracks"><ParameterList name="away"><Parameter name="Start" type="Array(double)" value="{0.3, 0.05}"/><Parameter name="End" type="Array(double)" value="{0.4, 0.05}"/></ParameterList></ParameterList>' '' >crack_outside.xml
 expect crack_outside 2 'mupm->Discretization->Pre-Cracks->away lies outside the body'
