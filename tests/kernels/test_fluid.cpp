@@ -89,6 +89,47 @@ GridSpec<Dim> grid() {
     return test::box<3>({15, 14, 14}, 3.015, 0.01);
 }
 
+// Plane stress with pore water (PoreCoupling, include/mupm/laws/micropolar_elastic.hpp), an
+// unsaturated field from p = -50 kPa to +20 kPa: the storage of fluid_constitutive is
+//   C = phi (dS/dp + S / K_w) + S (S + p dS/dp) / (lambda + 2 mu)
+// and the undrained modulus 2 mu / (lambda + 2 mu) S / C, with the 3D lambda, mu; and the stored
+// energy's thickness part (S p)^2 / (2 (lambda + 2 mu)) has the thickness part of C times p as
+// its derivative: storage and energy are the same term.
+TEST(FluidStorage, PlaneStressStorageAndStoredEnergy) {
+  const auto law = MicropolarElastic::from_bulk_shear(10e6, 6e6, 3e6, 0.01);
+  const double lam = law.lambda, mu = law.mu, phi = 0.3, Kw = 2.2e9;
+  FluidBody<2> body(grid<2>(), 0.5);
+  body.prm.retention = VanGenuchten::mualem(10e3, 2.0);
+  body.prm.bulk_modulus = Kw;
+  body.prm.pore = law.plane_stress().plane_stress_coupling();
+  body.set([](const double* x) { return -50e3 + 70e3 * x[0] / 0.24; });
+  fluid_constitutive(body.pts(), body.prm, body.st);
+  Kokkos::fence();
+  const VanGenuchten vg = body.prm.retention;
+  const double cz = body.prm.pore.lateral_compliance;
+  int checked = 0;
+  for (std::size_t i = 0; i < body.pts().n_owned; ++i) {
+    const double p = body.pts().p(i), S = vg.saturation(p), dS = vg.dsaturation_dp(p);
+    const double C = phi * (dS + S / Kw) + S * (S + p * dS) / (lam + 2 * mu);
+    EXPECT_NEAR(body.st.storage(i), C, 1e-12 * C) << "p = " << p;
+    EXPECT_NEAR(body.pts().undrained_modulus(i), 2 * mu / (lam + 2 * mu) * S / C, 1e-12 * S / C);
+    if (std::abs(p) < 100)
+      continue;
+    // The thickness's part of the stored energy (with c_z less without), whose derivative is
+    // the thickness's part of C p (the capillary part is a quadrature, good to ~1e-4 only).
+    const double h = 1e-4 * std::abs(p);
+    auto thickness = [&](double q) {
+      return stored_energy_density(vg, phi, 1 / Kw, q, cz) -
+             stored_energy_density(vg, phi, 1 / Kw, q, 0.0);
+    };
+    const double fd = (thickness(p + h) - thickness(p - h)) / (2 * h);
+    const double exact = S * (S + p * dS) / (lam + 2 * mu) * p;
+    EXPECT_NEAR(fd, exact, 1e-6 * std::abs(exact)) << "p = " << p;
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+}
+
 template <class T>
 class FluidKernels : public ::testing::Test {};
 using Dims = ::testing::Types<std::integral_constant<int, 2>, std::integral_constant<int, 3>>;
