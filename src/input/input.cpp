@@ -226,7 +226,8 @@ RCP<ParameterList> valid_parameters() {
           "pressure's in-plane coefficient becomes 2 mu / (lambda + 2 mu) and the storage gains "
           "1 / (lambda + 2 mu); Drucker-Prager returns to sigma_zz = 0, derivation in "
           "include/mupm/laws/micropolar_drucker_prager.hpp), for Solver->Physics = Micropolar "
-          "Solid or Hydro-Mechanical (not yet with Fracture->Fracture Flow).",
+          "Solid or Hydro-Mechanical (not yet with Fracture->Fracture Flow, nor Drucker-Prager "
+          "with pore water).",
           plane_options().validator());
     d.set("Boundary Layer Horizons", 2.0,
           "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
@@ -1060,6 +1061,15 @@ void check_dimension_arrays(ParameterList& input) {
                        path_of(input.sublist("Fracture"), "Fracture Flow") +
                        " = true (the crack water's coupling with the plate's thickness is not "
                        "derived): use Plane = Strain.");
+    const ParameterList& materials = input.sublist("Materials");
+    if (has_fluid(phys) && constitutive_model_options()(materials.get<std::string>("Model")) ==
+                               ConstitutiveModel::MicropolarDruckerPrager)
+      throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +
+                       path_of(materials, "Model") + " = " + materials.get<std::string>("Model") +
+                       " and Solver->Physics = " + physics +
+                       " (the return would have to reach sigma'_zz = S_r p, and the water the "
+                       "plastic thickness change): use Plane = Strain, or Physics = Micropolar "
+                       "Solid.");
   }
   if (has_solid(phys)) {
     const ParameterList& m = input.sublist("Materials");

@@ -401,7 +401,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
       law, m.grid, materials.get<double>("Stabilization"),
       stabilization_modulus_options()(materials.get<std::string>("Stabilization Modulus")));
   if (plane_stress)
-    m.solid.pore = law.plane_stress_coupling();
+    m.solid.pore = m.material.plane_stress_coupling();
   const double deg = kPi / 180;
   m.plasticity.friction = materials.get<double>("Friction Angle") * deg;
   m.plasticity.dilation = materials.get<double>("Dilation Angle") * deg;

@@ -101,7 +101,7 @@ TEST(FluidStorage, PlaneStressStorageAndStoredEnergy) {
   FluidBody<2> body(grid<2>(), 0.5);
   body.prm.retention = VanGenuchten::mualem(10e3, 2.0);
   body.prm.bulk_modulus = Kw;
-  body.prm.pore = law.plane_stress().plane_stress_coupling();
+  body.prm.pore = law.plane_stress_coupling();
   body.set([](const double* x) { return -50e3 + 70e3 * x[0] / 0.24; });
   fluid_constitutive(body.pts(), body.prm, body.st);
   Kokkos::fence();

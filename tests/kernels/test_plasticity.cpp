@@ -336,7 +336,7 @@ TEST(PlasticityDruckerPrager, PlaneStrainIsThe3DLawWithZeroOutOfPlaneStrain) {
 // Plane stress (drucker_prager_return_plane_stress, the 3D law with eps_zz free): while the point
 // stays elastic the stress is the plane-stress elastic law's (MicropolarElastic::plane_stress,
 // lambda* = 2 lambda mu / (lambda + 2 mu)) and sigma_zz = 0; a plastic return ends with sigma_zz =
-// 0 too, and with the 3D return's state at that eps_zz.
+// 0 too, to the return's tolerance, and says it converged.
 TEST(PlasticityDruckerPrager, PlaneStressElasticIsThePlaneStressLaw) {
   const auto el = soil();
   const auto dp = example3(25);
@@ -352,11 +352,12 @@ TEST(PlasticityDruckerPrager, PlaneStressElasticIsThePlaneStressLaw) {
   for (int k = 0; k < 2; ++k)
     EXPECT_NEAR(m[k], mref[k], 1e-9 * std::fabs(mref[0]));
   EXPECT_NEAR(szz, 0.0, 1e-9 * std::fabs(ref[0]));
-  // A plastic state: sigma_zz = 0 within the return's 1e-12 of the stress scale.
+  // A plastic state: sigma_zz = 0 within the return's tolerance (2e-10 k c0 here).
   const double big[4] = {0.01, 0.02, -0.005, -0.015}, kbig[2] = {1.5, -2.0};
   drucker_prager_return_plane_stress(el, dp, big, kbig, old, nw, sig, &szz, m, &info);
   ASSERT_TRUE(info.plastic);
-  EXPECT_LT(std::fabs(szz), 1e-11 * std::max(std::fabs(sig[0]), dp.cohesion));
+  EXPECT_TRUE(info.converged);
+  EXPECT_LT(std::fabs(szz), 1e-9 * std::max(std::fabs(sig[0]), dp.cohesion));
 }
 
 // In-plane uniaxial stress in plane stress, sigma_yy = sigma_zz = 0, perfectly plastic (h = 0):
@@ -389,9 +390,11 @@ TEST(PlasticityDruckerPrager, PlaneStressUniaxialYieldStress) {
         // sigma_yy(eps_yy) = 0 by secant steps from the last eps_yy, slope first E.
         auto syy = [&](double e) {
           const double eps[4] = {exx, 0, 0, e};
-          if (plane_stress)
-            drucker_prager_return_plane_stress(el, dp, eps, kap, old, nw, sig, &szz, m);
-          else
+          if (plane_stress) {
+            ReturnInfo info;
+            drucker_prager_return_plane_stress(el, dp, eps, kap, old, nw, sig, &szz, m, &info);
+            EXPECT_TRUE(info.converged);
+          } else
             drucker_prager_return<2>(el, dp, eps, kap, old, nw, sig, &szz, m);
           return sig[3];
         };
@@ -407,7 +410,7 @@ TEST(PlasticityDruckerPrager, PlaneStressUniaxialYieldStress) {
         eyy = e1;
         old = nw;
         if (plane_stress) {
-          EXPECT_LT(std::fabs(szz), 1e-10 * std::fabs(yield));
+          EXPECT_LT(std::fabs(szz), 1e-9 * std::fabs(yield));
           if (std::fabs(E * exx) < 0.9 * std::fabs(yield))  // well inside the elastic range
             elastic_err = std::max(elastic_err, std::fabs(sig[0] / (E * exx) - 1));
         }

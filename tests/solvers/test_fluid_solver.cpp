@@ -632,8 +632,8 @@ TEST(FluidSolverLong, TerzaghiSemiImplicitMirrored) {
 Terzaghi plane_stress_column(double Kw, int N, double transits, bool semi_implicit) {
   Terzaghi tz;
   const double lam = tz.law.lambda, mu = tz.law.mu;
-  tz.law = tz.law.plane_stress();
   tz.pore = tz.law.plane_stress_coupling();
+  tz.law = tz.law.plane_stress();
   tz.Kw = Kw;
   tz.M = 4 * mu * (lam + mu) / (lam + 2 * mu);
   tz.S = tz.phi / Kw + 1 / (lam + mu);
@@ -797,7 +797,7 @@ struct SealedBody {
       law = law.plane_stress();
     auto sp = solid_params(law, g, 0.5);
     if (plane_stress)
-      sp.pore = fp.pore = law.plane_stress_coupling();
+      sp.pore = fp.pore = material().plane_stress_coupling();
     fluid = std::make_unique<FluidSolver<2>>(disc, fp, bcs, MPI_COMM_WORLD);
     if (!explicit_water)
       fluid->enable_semi_implicit(LinearSolveSettings());

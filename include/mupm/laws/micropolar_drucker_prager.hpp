@@ -28,9 +28,11 @@
 // is the same 3D return with the total eps_zz as a parameter, eps^e_zz = eps_zz - eps^p_zz, and
 // eps_zz is the root of sigma_zz(eps_zz) = 0 (drucker_prager_return_plane_stress): it starts
 // from the elastic plane-stress value eps^p_zz - lambda tr(eps^e) / (lambda + 2 mu) (exact where
-// the point stays elastic), then secant steps, bisection once the root is bracketed. The
-// slope d sigma_zz / d eps_zz is at most the elastic lambda + 2 mu, so a first step -sigma_zz /
-// (lambda + 2 mu) never passes the root. The state keeps eps^p_zz as in plane strain; eps_zz
+// the point stays elastic), then a step -sigma_zz / (lambda + 2 mu), secant steps, and bisection
+// once the root is bracketed (the plastic slope d sigma_zz / d eps_zz may exceed the elastic one
+// when psi != phi, or fall with softening: the bracket keeps the iteration safe). Pore water in
+// plane stress would need sigma'_zz = S_r p here and its plastic eps_zz in the water's balance:
+// not derived, an input error. The state keeps eps^p_zz as in plane strain; eps_zz
 // itself follows from the strain and the state, so it is not kept. q, p-bar and the flow are
 // the 3D ones: the yield stress under in-plane uniaxial stress is the 3D one,
 // k c / (1 + a1 / sqrt3) in tension (tests/kernels/test_plasticity.cpp).
@@ -104,6 +106,7 @@ struct ReturnInfo {
   double f = 0;        // yield function after the return
   bool plastic = false;
   bool apex = false;
+  bool converged = true;  // plane stress: sigma_zz = 0 reached (drucker_prager_return_plane_stress)
 };
 
 namespace dp_detail {
@@ -285,8 +288,10 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return(
 }
 
 // Plane stress (header): the return of drucker_prager_return<2> with the total eps_zz that makes
-// sigma_zz = 0, to |sigma_zz| <= 1e-12 of the stress's scale (the largest of |sigma|, |m| / l
-// and k c0). `el` is the 3D law (not its plane_stress()). *szz is the residual sigma_zz.
+// sigma_zz = 0, to |sigma_zz| <= the larger of 1e-12 of the stress's scale (the largest of
+// |sigma|, |m| / l and k c0) and twice the inner return's tolerance on f (sigma_zz(eps_zz) is
+// continuous only to that). `el` is the 3D law (not its plane_stress()). *szz is the residual
+// sigma_zz; info->converged is false if 100 returns or a bracket of a few ulps did not reach it.
 KOKKOS_INLINE_FUNCTION double drucker_prager_return_plane_stress(
     const MicropolarElastic& el, const DruckerPragerParams& dp, const double* eps,
     const double* kappa, const PlasticPoint<2>& old, PlasticPoint<2>& nw, double* sigma,
@@ -301,7 +306,9 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return_plane_stress(
   const double l = el.length > 0 ? el.length : 1.0;
   for (int k = 0; k < 2; ++k)
     scale = std::fabs(m[k]) / l > scale ? std::fabs(m[k]) / l : scale;
-  const double tol = 1e-12 * scale;
+  const double inner =
+      2 * dp.tolerance * dp.k() * (dp.cohesion > dp.residual ? dp.cohesion : dp.residual);
+  const double tol = 1e-12 * scale > inner ? 1e-12 * scale : inner;
   double g = *szz, e_prev = e, g_prev = g;
   bool have_lo = false, have_hi = false;  // bracket: sigma_zz(lo) < 0 < sigma_zz(hi)
   double lo = 0, hi = 0;
@@ -319,14 +326,20 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return_plane_stress(
       if (slope > 0)
         next = e - g / slope;
     }
-    if (have_lo && have_hi && !(next > lo && next < hi))
-      next = 0.5 * (lo + hi);
+    if (have_lo && have_hi) {
+      if (hi - lo <= 4e-16 * (std::fabs(lo) + std::fabs(hi)))
+        break;  // a bracket of a few ulps: sigma_zz jumps across it
+      if (!(next > lo && next < hi))
+        next = 0.5 * (lo + hi);
+    }
     e_prev = e;
     g_prev = g;
     e = next;
     w = drucker_prager_return<2>(el, dp, eps, kappa, old, nw, sigma, szz, m, info, true, e);
     g = *szz;
   }
+  if (info)
+    info->converged = std::fabs(g) <= tol;
   return w;
 }
 

@@ -43,23 +43,24 @@ struct MicropolarElastic {
   MicropolarElastic plane_stress() const {
     return {2 * lambda * mu / (lambda + 2 * mu), mu, mu_c, length};
   }
-  // The pore water in plane stress, from this plane-stress law (lambda* = 2 lambda mu / (lambda +
-  // 2 mu)). With the total sigma_zz = lambda (tr eps + eps_zz) + 2 mu eps_zz - S_r p = 0 (tr over
-  // the plane), eps_zz = (S_r p - lambda tr eps) / (lambda + 2 mu), so
+  // The pore water in plane stress (PoreCoupling), of this 3D law. With the total sigma_zz =
+  // lambda (tr eps + eps_zz) + 2 mu eps_zz - S_r p = 0 (tr over the plane),
+  // eps_zz = (S_r p - lambda tr eps) / (lambda + 2 mu), so
   //   in-plane total stress  = eq 80 with lambda* - (2 mu / (lambda + 2 mu)) S_r p 1,
   //   volume strain (3D)     = (2 mu / (lambda + 2 mu)) tr eps + S_r p / (lambda + 2 mu):
-  // the same coefficient biot = 2 mu / (lambda + 2 mu) = 1 - lambda* / (2 mu) in the force and in
-  // the mass balance (the coupling stays symmetric, so the energy balance still closes), and the
-  // water's storage gains S_r d(S_r p)/dp / (lambda + 2 mu), 1 / (lambda + 2 mu) = biot / (2 mu):
-  // the thickness swells with the pressure. Its energy (S_r p)^2 / (2 (lambda + 2 mu)) is the
-  // eps_zz part of the skeleton's strain energy, booked with the water's stored energy
-  // (include/mupm/kernels/fluid.hpp). Checks: saturated, incompressible water and grains under an
-  // in-plane all-round pressure q take p = 2q/3 (not q), and the one-dimensional consolidation
-  // modulus becomes lambda* + 2 mu with storage phi/K_w + 1/(lambda + mu)
-  // (tests/solvers/test_fluid_solver.cpp, the plane-stress entries).
+  // the same coefficient biot = 2 mu / (lambda + 2 mu) in the force and in the mass balance (the
+  // coupling stays symmetric, so the energy balance still closes), and the water's storage gains
+  // S_r d(S_r p)/dp / (lambda + 2 mu): the thickness swells with the pressure. Its energy
+  // (S_r p)^2 / (2 (lambda + 2 mu)) is the eps_zz part of the skeleton's strain energy, booked
+  // with the water's stored energy (include/mupm/kernels/fluid.hpp). Checks: saturated,
+  // incompressible water and grains under an in-plane all-round pressure q take p = 2q/3 (not
+  // q), and the one-dimensional consolidation modulus becomes lambda* + 2 mu with storage
+  // phi/K_w + 1/(lambda + mu) (tests/solvers/test_fluid_solver.cpp, the plane-stress entries).
+  // Elastic only: a plastic law would have to return to sigma'_zz = S_r p and give the water its
+  // plastic eps_zz (not derived; src/input/input.cpp refuses Drucker-Prager with pore water in
+  // plane stress).
   PoreCoupling plane_stress_coupling() const {
-    const double biot = 1 - lambda / (2 * mu);
-    return {biot, biot / (2 * mu)};
+    return {2 * mu / (lambda + 2 * mu), 1 / (lambda + 2 * mu)};
   }
   double young() const { return mu * (3 * lambda + 2 * mu) / (lambda + mu); }
   double poisson() const { return lambda / (2 * (lambda + mu)); }

@@ -8,10 +8,11 @@
 // vol_strain. Solid first: the interval is the solid steps just taken. Fluid first: it is the
 // previous interval (the first update of a run sees no change).
 //
-// Mass bookkeeping: fluid_content m_i starts as phi S_r (1 + p/K_w) and every step adds
-// C dp + S_r d(tr eps), which by the mass balance equals dt (s_i - div_i) on free points. On a
+// Mass bookkeeping: fluid_content m_i starts as phi S_r (1 + p/K_w) (plus c_z S_r^2 p in plane
+// stress) and every step adds C dp + biot S_r d(tr eps) (PoreCoupling: biot = 1, c_z = 0 but in
+// plane stress), which by the mass balance equals dt (s_i - div_i) on free points. On a
 // prescribed-pressure point the reservoir supplies what the balance needs,
-//   supply_i = V_i (C dp + S_r d(tr eps) + dt div_i - dt s_i),
+//   supply_i = V_i (C dp + biot S_r d(tr eps) + dt div_i - dt s_i),
 // and sum_i V_i div_i = 0 (each bond's flow appears with both signs), so
 //   rho_w sum_i V_i m_i (t) - rho_w sum_i V_i m_i (0) = inflow through pressure conditions +
 //   injected water, to round-off. The test FluidSolver.MassConservation checks both.

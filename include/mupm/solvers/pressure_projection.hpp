@@ -10,7 +10,9 @@
 //   water     V C dp/dt + B~ (u, theta)' = -V H p + V g_w + V s             (eqs 14, 116, 143)
 // with B~ and V H of include/mupm/solvers/pressure_system.hpp (B~^T p is the pore water's
 // force, V H the flow operator, g_w its gravity part, s the sources, C = phi dS_r/dp +
-// phi S_r / K_w the storage, which may be zero: incompressible water).
+// phi S_r / K_w the storage, which may be zero: incompressible water; in plane stress S_r is
+// biot S_r in B~ and C gains the thickness's compliance, PoreCoupling in
+// include/mupm/laws/micropolar_elastic.hpp).
 //
 // The step n -> n + 1 (velocity Verlet, include/mupm/kernels/central_difference.hpp):
 //  1. move: v* = v_n + dt/2 a_n, (u*, theta*) = (u_n, theta_n) + dt v*, with a_n from the
@@ -48,7 +50,7 @@
 // refuses (src/input/input.cpp, check_pressure_integration).
 //
 // What it conserves. Water: each free point's balance holds to the linear solve's tolerance;
-// the bookkeeping (FluidSolver::finish_projection) adds C dp + S_r d(tr eps) to the water
+// the bookkeeping (FluidSolver::finish_projection) adds C dp + biot S_r d(tr eps) to the water
 // content with the skeleton's actual volume change and the linearized flow div(p_n) + H dp,
 // whose volume integral is zero (H 1 = 0), so the CSV's water mass error is the accumulated
 // residual of the solves. Energy: the solid's ledger is the central difference's
@@ -80,7 +82,8 @@
 // (measured: relative residual 0.22 after 1000 iterations). The remedy is the flow
 // stabilization itself with a mobility of the projection's scale, on the increment only:
 // every point's alpha_i gets
-//   alpha_p,i = G_p S_r,i^2 dt / (rho_i k2 w0_i)   (eq 76's with lambda -> G_p S_r^2 dt / rho),
+//   alpha_p,i = G_p S_r,i^2 dt / (rho_i k2 w0_i)   (eq 76's with lambda -> G_p S_r^2 dt / rho;
+//   biot S_r in plane stress),
 // in the matrix's flow operator (not in the right-hand side's div(p_n)). Why that mobility: for
 // a smooth field B~ M^-1 B~^T -> -V div((S_r^2 / rho) grad), so dt^2 times it is a flow term
 // dt V H with lambda = S_r^2 dt / rho; the stabilization then holds the modes the projection
