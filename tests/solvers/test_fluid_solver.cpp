@@ -602,7 +602,7 @@ Terzaghi semi_implicit_column(double Kw, int N, double transits) {
 // max |p - p_cf| / p0 within 1 % at T_v = 0.2 and 0.5 beyond the first 2 dx, as the explicit
 // runs reach. (Without the pressure stabilization the stiff and incompressible columns grew
 // without bound: their images answered the checkerboard modes, pressure_projection.hpp.)
-TEST(FluidSolverLong, TerzaghiSemiImplicitMirrored) {
+TEST(FluidSolverSemiImplicitLong, TerzaghiSemiImplicitMirrored) {
   for (const double Kw : {Terzaghi().Kw, 2.2e9, std::numeric_limits<double>::infinity()}) {
     SCOPED_TRACE("K_w = " + std::to_string(Kw));
     if (test::world()->getRank() == 0)
@@ -669,7 +669,7 @@ TEST(FluidSolverLong, TerzaghiPlaneStress) {
 
 // Incompressible water (no explicit step at all) with the paper's constant drained layers,
 // whose kink at the face is an error of first order in delta / H: check_richardson.
-TEST(FluidSolverLong, TerzaghiSemiImplicitIncompressible) {
+TEST(FluidSolverSemiImplicitLong, TerzaghiSemiImplicitIncompressible) {
   const double inf = std::numeric_limits<double>::infinity();
   const TerzaghiResult coarse = solve_terzaghi(semi_implicit_column(inf, 10, 400), false, 3, true),
                        fine = solve_terzaghi(semi_implicit_column(inf, 20, 400), false, 3, true);
