@@ -226,7 +226,8 @@ RCP<ParameterList> valid_parameters() {
           "pressure's in-plane coefficient becomes 2 mu / (lambda + 2 mu) and the storage gains "
           "1 / (lambda + 2 mu); Drucker-Prager returns to sigma_zz = 0, derivation in "
           "include/mupm/laws/micropolar_drucker_prager.hpp), for Solver->Physics = Micropolar "
-          "Solid or Hydro-Mechanical (not yet with Fracture->Fracture Flow, nor Drucker-Prager "
+          "Solid or Hydro-Mechanical (with Fracture->Fracture Flow the crack water pushes the "
+          "faces in the plane, include/mupm/solvers/fracture_flow.hpp; not yet Drucker-Prager "
           "with pore water).",
           plane_options().validator());
     d.set("Boundary Layer Horizons", 2.0,
@@ -1056,11 +1057,6 @@ void check_dimension_arrays(ParameterList& input) {
       throw InputError("Error, " + path_of(disc, "Plane") +
                        " = Stress needs a skeleton (Solver->Physics = " + physics +
                        " has none): use Plane = Strain.");
-    if (has_fluid(phys) && input.sublist("Fracture").get<bool>("Fracture Flow"))
-      throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +
-                       path_of(input.sublist("Fracture"), "Fracture Flow") +
-                       " = true (the crack water's coupling with the plate's thickness is not "
-                       "derived): use Plane = Strain.");
     const ParameterList& materials = input.sublist("Materials");
     if (has_fluid(phys) && constitutive_model_options()(materials.get<std::string>("Model")) ==
                                ConstitutiveModel::MicropolarDruckerPrager)

@@ -41,6 +41,16 @@
 // place of G'), M_f = 0 (the solid applies p_f itself) and the opening's work is booked with the
 // opening the step reached after the pressure's correction.
 //
+// Plane stress (Discretization->Plane = Stress). The crack is a slit through the plate's
+// thickness: its water pushes the faces, whose normals lie in the plane, so p_f loads the plane
+// only. It takes no share of sigma_zz, so none of the bulk water's plane-stress coupling
+// (PoreCoupling, include/mupm/laws/micropolar_elastic.hpp: biot 2 mu / (lambda + 2 mu) and the
+// thickness compliance in the storage, which come from the pore pressure acting in z as well)
+// applies to p_f: the face forces, C_f, phi_f and M_f are plane strain's, per unit thickness. The
+// bulk side of the exchange keeps its own coupling (the predictor p^ and its storage C are the
+// bulk's, fluid_solver.hpp). Left out: the slit's volume change with the plate's thickness, phi_f
+// d(eps_zz), beside the opening's d(phi_f): phi_f eps_zz ~ 1e-4 of it at strains of 1e-4.
+//
 // The solve is distributed as the points are: each rank assembles the rows of its own fracture
 // points as a Tpetra CrsMatrix over the network's map (the owned fracture points' global ids),
 // its neighbours' data reaching it with the ghosts (two refreshes: on the network, held, p_f^n;
