@@ -227,8 +227,9 @@ RCP<ParameterList> valid_parameters() {
           "1 / (lambda + 2 mu); Drucker-Prager returns to sigma_zz = 0, derivation in "
           "include/mupm/laws/micropolar_drucker_prager.hpp), for Solver->Physics = Micropolar "
           "Solid or Hydro-Mechanical (with Fracture->Fracture Flow the crack water pushes the "
-          "faces in the plane, include/mupm/solvers/fracture_flow.hpp; not yet Drucker-Prager "
-          "with pore water).",
+          "faces in the plane, include/mupm/solvers/fracture_flow.hpp; Drucker-Prager with pore "
+          "water returns to sigma'_zz = S_r p and gives the water its plastic thickness change, "
+          "with Pressure Integration = Explicit only).",
           plane_options().validator());
     d.set("Boundary Layer Horizons", 2.0,
           "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
@@ -1058,14 +1059,19 @@ void check_dimension_arrays(ParameterList& input) {
                        " = Stress needs a skeleton (Solver->Physics = " + physics +
                        " has none): use Plane = Strain.");
     const ParameterList& materials = input.sublist("Materials");
-    if (has_fluid(phys) && constitutive_model_options()(materials.get<std::string>("Model")) ==
-                               ConstitutiveModel::MicropolarDruckerPrager)
-      throw InputError("Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +
-                       path_of(materials, "Model") + " = " + materials.get<std::string>("Model") +
-                       " and Solver->Physics = " + physics +
-                       " (the return would have to reach sigma'_zz = S_r p, and the water the "
-                       "plastic thickness change): use Plane = Strain, or Physics = Micropolar "
-                       "Solid.");
+    const ParameterList& solver = input.sublist("Solver");
+    if (has_fluid(phys) &&
+        constitutive_model_options()(materials.get<std::string>("Model")) ==
+            ConstitutiveModel::MicropolarDruckerPrager &&
+        pressure_integration_options()(solver.get<std::string>("Pressure Integration")) ==
+            PressureIntegration::SemiImplicit)
+      throw InputError(
+          "Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +
+          path_of(materials, "Model") + " = " + materials.get<std::string>("Model") + " and " +
+          path_of(solver, "Pressure Integration") + " = " +
+          solver.get<std::string>("Pressure Integration") +
+          " (the projection's water balance would need the plastic thickness change, which the "
+          "explicit scheme books): use Pressure Integration = Explicit, or Plane = Strain.");
   }
   if (has_solid(phys)) {
     const ParameterList& m = input.sublist("Materials");

@@ -332,7 +332,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
         attach(std::make_unique<SolidSolver<Dim, MicropolarDruckerPrager<Dim>>>(
             disc, model.solid, model.boundary_conditions, settings, mpi,
             MicropolarDruckerPrager<Dim>(model.material, model.plasticity, disc.points,
-                                         model.plane_stress)));
+                                         model.plane_stress, has_fluid(physics))));
         break;
     }
   } else if (physics == Physics::KinematicsOnly) {

@@ -285,8 +285,8 @@ TEST(Input, SolidAndBoundaryConditions) {
 // (K = 1e8, mu = 5e7: lambda = 6.667e7, lambda* = 3.333e7); Strain keeps lambda. With pore water
 // the pressure's coefficient is 2 mu / (lambda + 2 mu) = 0.6 and the storage gains
 // 1 / (lambda + 2 mu) = 6e-9 / Pa in both the solid's and the fluid's parameters (1 and 0 in plane
-// strain). Plane stress is refused in 3D, without a skeleton and with Drucker-Prager and pore
-// water, naming the parameters; with Fracture Flow it is accepted.
+// strain). Plane stress is refused in 3D, without a skeleton and with Drucker-Prager, pore water
+// and the semi-implicit pressure, naming the parameters; with Fracture Flow it is accepted.
 TEST(Input, PlaneStress) {
   const std::string stress = "<Parameter name=\"Plane\" type=\"string\" value=\"Stress\"/>";
   const double lambda = 1e8 - 2 * 5e7 / 3.0, mu = 5e7;
@@ -348,14 +348,21 @@ TEST(Input, PlaneStress) {
   EXPECT_TRUE(m.plane_stress);
   EXPECT_DOUBLE_EQ(m.material.lambda, lambda);
   EXPECT_DOUBLE_EQ(m.solid.law.lambda, 2 * lambda * mu / (lambda + 2 * mu));
-  // With pore water Drucker-Prager is refused (its return keeps sigma'_zz = 0).
+  // With pore water Drucker-Prager is accepted with the explicit pressure, refused with the
+  // semi-implicit one (its projection leaves out the plastic thickness change).
   std::string wet_dp = physics("Hydro-Mechanical");
   wet_dp.insert(wet_dp.find("<Parameter name=\"Porosity\""),
                 "<Parameter name=\"Model\" type=\"string\" value=\"Micropolar Drucker-Prager\"/>"
                 "<Parameter name=\"Cohesion\" type=\"double\" value=\"1e4\"/>");
-  expect_error(xml(kOk + stress, wet_dp), {"mupm->Discretization->Plane = Stress",
-                                           "mupm->Materials->Model = Micropolar Drucker-Prager",
-                                           "Physics = Hydro-Mechanical"});
+  validate_input(*parse_input(xml(kOk + stress, wet_dp)));
+  std::string wet_dp_si = wet_dp;
+  wet_dp_si.insert(wet_dp_si.find("</ParameterList>"),
+                   "<Parameter name=\"Pressure Integration\" type=\"string\" "
+                   "value=\"Semi-Implicit\"/>");
+  expect_error(
+      xml(kOk + stress, wet_dp_si),
+      {"mupm->Discretization->Plane = Stress", "mupm->Materials->Model = Micropolar Drucker-Prager",
+       "mupm->Solver->Pressure Integration = Semi-Implicit", "Explicit"});
 }
 
 TEST(Input, MalformedXml) {

@@ -68,7 +68,7 @@ struct Points {
   Scalars porosity, saturation;
   Scalars rel_perm;             // relative permeability k_r (eq 56)
   Vectors darcy_flux;           // q [m/s] (eq 54) [n][Dim]
-  Scalars vol_strain;           // tr(eps) of the solid (eq 117)
+  Scalars vol_strain;           // tr(eps) of the solid (eq 117; + pore_shift of the plastic law)
   Scalars vol_strain_ref;       // tr(eps) at the last fluid update
   Scalars fluid_content;        // water volume per unit volume, phi S_r (1 + p/K_w) at t = 0 plus
                                 // the increments C dp + S_r d(tr eps) of every fluid step

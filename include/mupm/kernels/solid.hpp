@@ -218,8 +218,18 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
           mat_mul<Dim, Dim>(A, Kinv, eps);
           mat_mul<R, Dim>(B, Kinv, kap);
         }
+        // The pore pressure of the total stress, sigma-bar - biot S_r p* 1 (eq 46): p* of the
+        // undrained split (header), with the plastic law's shift of the volumetric strain
+        // (plane stress with pore water, laws/micropolar_drucker_prager.hpp; 0 otherwise).
+        double pe = p(i);
+        if (bu(i) != 0) {
+          double tr_eps = law.pore_shift_start(i);
+          for (int d = 0; d < Dim; ++d)
+            tr_eps += eps[d * Dim + d];
+          pe -= bu(i) * (tr_eps - ref(i));  // undrained split (header)
+        }
         double sig[Dim * Dim], m[R * Dim];
-        double w = law.template stress<Dim>(i, eps, kap, sig, m);
+        double w = law.template stress<Dim>(i, eps, kap, sig, m, sr(i) * pe);
         if (singular)
           w = 0;
         const double w0 = wsum * inv_vh;
@@ -255,13 +265,6 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
           }
         }
         // Total stress sigma-bar - biot S_r p* 1 (eq 46) less the stabilization stress, times K^-1.
-        double pe = p(i);
-        if (bu(i) != 0) {
-          double tr_eps = 0;
-          for (int d = 0; d < Dim; ++d)
-            tr_eps += eps[d * Dim + d];
-          pe -= bu(i) * (tr_eps - ref(i));  // undrained split (header)
-        }
         const double bsp = biot * sr(i) * pe;  // PoreCoupling: biot = 1 but in plane stress
         double S[Dim * Dim], Mm[R * Dim], p1[Dim * Dim], p2[R * Dim];
         for (int a = 0; a < Dim; ++a)

@@ -30,12 +30,35 @@
 // from the elastic plane-stress value eps^p_zz - lambda tr(eps^e) / (lambda + 2 mu) (exact where
 // the point stays elastic), then a step -sigma_zz / (lambda + 2 mu), secant steps, and bisection
 // once the root is bracketed (the plastic slope d sigma_zz / d eps_zz may exceed the elastic one
-// when psi != phi, or fall with softening: the bracket keeps the iteration safe). Pore water in
-// plane stress would need sigma'_zz = S_r p here and its plastic eps_zz in the water's balance:
-// not derived, an input error. The state keeps eps^p_zz as in plane strain; eps_zz
-// itself follows from the strain and the state, so it is not kept. q, p-bar and the flow are
-// the 3D ones: the yield stress under in-plane uniaxial stress is the 3D one,
-// k c / (1 + a1 / sqrt3) in tension (tests/kernels/test_plasticity.cpp).
+// when psi != phi, or fall with softening: the bracket keeps the iteration safe). The state keeps
+// eps^p_zz as in plane strain; eps_zz itself follows from the strain and the state, so it is not
+// kept. q, p-bar and the flow are the 3D ones: the yield stress under in-plane uniaxial stress is
+// the 3D one, k c / (1 + a1 / sqrt3) in tension (tests/kernels/test_plasticity.cpp).
+// Plane stress with pore water (Bishop's sigma-bar - S_r p 1, eq 46): the total sigma_zz = 0, so
+// the return solves sigma-bar_zz(eps_zz) = s = S_r p* (p* the pressure of pass 1) instead of 0,
+// and the yield function sees the effective stress with that sigma-bar_zz. What the skeleton and
+// the water then need, with t = tr eps (in-plane), e = eps_zz, L = lambda + 2 mu:
+//  - Thickness: sigma-bar_zz = lambda tr(eps^e) + 2 mu e^e = s (3D trace) gives
+//      e = eps^p_zz + (s - lambda (t - tr2 eps^p)) / L,
+//    so the 3D volume change is t + e = biot t + c_z s + Pi with the elastic PoreCoupling's
+//    biot = 2 mu / L, c_z = 1 / L (micropolar_elastic.hpp) and the plastic part
+//      Pi = (lambda tr eps^p + 2 mu eps^p_zz) / L   (tr eps^p over the 3 axes).
+//    The water's balance (eq 117) takes S_r d(t + e): the elastic coupling's terms plus S_r dPi.
+//    The law gives the solver t + Pi / biot as the volumetric strain (pore_shift): with it the
+//    water's biot S_r d(volumetric strain), the undrained split and the solid's pore work are
+//    the elastic coupling's expressions, and the plastic thickness change is in all three.
+//  - In-plane stress: the total is sigma-bar_in - s 1; the solid subtracts biot s 1 (as for the
+//    elastic law), so the law returns sigma-bar_in - (lambda / L) s 1, which while elastic is
+//    exactly the plane-stress elastic law (lambda* of micropolar_elastic.hpp).
+//  - Energy: with W3 the 3D stored energy of eps^e, the law returns W3 - s^2 / (2 L): while
+//    elastic this is the plane-stress law's W, and s^2 / (2 L) is the thickness energy the water's
+//    stored energy holds (kernels/fluid.hpp, c_z). Over a step, exactly for the trapezoid,
+//      1/2 (sig0 + sig1) : dt-eps (returned stresses) = d(W3 - s^2 / (2 L)) + D - s-bar dPi,
+//    D the 3D plastic dissipation (with its sigma-bar_zz d eps^p_zz term, dissipation()), so the
+//    solid's ledger closes with the pore work biot s-bar d(t + Pi / biot).
+// The water's share of the split uses the plastic state at the step's start (the return that
+// gives the new Pi needs p* itself): the plastic thickness change reaches p* a step late, the
+// water's balance on the step it happens (mass is exact).
 //
 // Return mapping (backward Euler, closest point in the energy norm). With x = d lambda and the
 // trial state (s_t, m_t, p_t) of the elastic predictor:
@@ -288,17 +311,18 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return(
 }
 
 // Plane stress (header): the return of drucker_prager_return<2> with the total eps_zz that makes
-// sigma_zz = 0, to |sigma_zz| <= the larger of 1e-12 of the stress's scale (the largest of
-// |sigma|, |m| / l and k c0) and twice the inner return's tolerance on f (sigma_zz(eps_zz) is
-// continuous only to that). `el` is the 3D law (not its plane_stress()). *szz is the residual
-// sigma_zz; info->converged is false if 100 returns or a bracket of a few ulps did not reach it.
+// sigma-bar_zz = target (0 when dry; S_r p* with pore water, header), to |sigma-bar_zz - target|
+// <= the larger of 1e-12 of the stress's scale (the largest of |sigma|, |m| / l, |target| and
+// k c0) and twice the inner return's tolerance on f (sigma_zz(eps_zz) is continuous only to
+// that). `el` is the 3D law (not its plane_stress()). *szz is the sigma-bar_zz reached;
+// info->converged is false if 100 returns or a bracket of a few ulps did not reach it.
 KOKKOS_INLINE_FUNCTION double drucker_prager_return_plane_stress(
     const MicropolarElastic& el, const DruckerPragerParams& dp, const double* eps,
     const double* kappa, const PlasticPoint<2>& old, PlasticPoint<2>& nw, double* sigma,
-    double* szz, double* m, ReturnInfo* info = nullptr) {
+    double* szz, double* m, ReturnInfo* info = nullptr, double target = 0) {
   const double stiff = el.lambda + 2 * el.mu;  // the elastic d sigma_zz / d eps_zz, an upper bound
   const double tr = eps[0] - old.ep[0] + eps[3] - old.ep[3];
-  double e = old.ezz - el.lambda * tr / stiff;  // the elastic plane-stress eps_zz
+  double e = old.ezz + (target - el.lambda * tr) / stiff;  // the elastic plane-stress eps_zz
   double w = drucker_prager_return<2>(el, dp, eps, kappa, old, nw, sigma, szz, m, info, true, e);
   double scale = dp.k() * (dp.cohesion > dp.residual ? dp.cohesion : dp.residual);
   for (int k = 0; k < 4; ++k)
@@ -308,9 +332,10 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return_plane_stress(
     scale = std::fabs(m[k]) / l > scale ? std::fabs(m[k]) / l : scale;
   const double inner =
       2 * dp.tolerance * dp.k() * (dp.cohesion > dp.residual ? dp.cohesion : dp.residual);
+  scale = std::fabs(target) > scale ? std::fabs(target) : scale;
   const double tol = 1e-12 * scale > inner ? 1e-12 * scale : inner;
-  double g = *szz, e_prev = e, g_prev = g;
-  bool have_lo = false, have_hi = false;  // bracket: sigma_zz(lo) < 0 < sigma_zz(hi)
+  double g = *szz - target, e_prev = e, g_prev = g;
+  bool have_lo = false, have_hi = false;  // bracket: g(lo) < 0 < g(hi)
   double lo = 0, hi = 0;
   for (int it = 0; it < 100 && std::fabs(g) > tol; ++it) {
     if (g < 0) {
@@ -336,7 +361,7 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return_plane_stress(
     g_prev = g;
     e = next;
     w = drucker_prager_return<2>(el, dp, eps, kappa, old, nw, sigma, szz, m, info, true, e);
-    g = *szz;
+    g = *szz - target;
   }
   if (info)
     info->converged = std::fabs(g) <= tol;
@@ -366,6 +391,7 @@ struct MicropolarDruckerPrager {
   MicropolarElastic elastic;  // the 3D law (in plane stress too: the return is 3D)
   DruckerPragerParams dp;
   bool plane_stress = false;       // 2D, Discretization->Plane = Stress
+  bool pore_water = false;         // plane stress with pore water: sigma-bar_zz = S_r p* (header)
   Vectors start;                   // Points::plastic_step_start
   Vectors ep, kp;                  // current eps^p, kappa^p
   Scalars ezz, eq, vol, coh, szz;  // eps^p_zz, eps-hat^p, tr eps^p, c, sigma_zz
@@ -373,10 +399,11 @@ struct MicropolarDruckerPrager {
   MicropolarDruckerPrager() = default;
   template <class Points>
   MicropolarDruckerPrager(const MicropolarElastic& el, const DruckerPragerParams& d,
-                          const Points& p, bool plane = false)
+                          const Points& p, bool plane = false, bool water = false)
       : elastic(el),
         dp(d),
         plane_stress(Dim == 2 && plane),
+        pore_water(Dim == 2 && plane && water),
         start(p.plastic_step_start),
         ep(p.plastic_strain),
         kp(p.plastic_wryness),
@@ -387,9 +414,11 @@ struct MicropolarDruckerPrager {
         szz(p.stress_zz) {}
 
   // Pass 1's constitutive update at owned point i (eqs 80-95): the return from the start state.
+  // srp: S_r p* of the point (pass 1's pressure), the target of sigma-bar_zz in plane stress
+  // with pore water (header); not used otherwise.
   template <int D>
   KOKKOS_INLINE_FUNCTION double stress(std::size_t i, const double* eps, const double* kappa,
-                                       double* sigma, double* m) const {
+                                       double* sigma, double* m, double srp = 0) const {
     static_assert(D == Dim, "the law's dimension");
     PlasticPoint<Dim> old, nw;
     for (int k = 0; k < Dim * Dim; ++k)
@@ -400,11 +429,21 @@ struct MicropolarDruckerPrager {
     old.eq = start(i, kEq);
     double sz = 0;
     double w;
-    if constexpr (Dim == 2)
-      w = plane_stress
-              ? drucker_prager_return_plane_stress(elastic, dp, eps, kappa, old, nw, sigma, &sz, m)
-              : drucker_prager_return<Dim>(elastic, dp, eps, kappa, old, nw, sigma, &sz, m);
-    else
+    if constexpr (Dim == 2) {
+      if (plane_stress) {
+        const double s = pore_water ? srp : 0.0;
+        w = drucker_prager_return_plane_stress(elastic, dp, eps, kappa, old, nw, sigma, &sz, m,
+                                               nullptr, s);
+        if (pore_water) {  // the solid subtracts biot s 1, the total needs s 1 (header)
+          const double L = elastic.lambda + 2 * elastic.mu;
+          sigma[0] -= elastic.lambda / L * s;
+          sigma[3] -= elastic.lambda / L * s;
+          w -= 0.5 * s * s / L;
+        }
+      } else {
+        w = drucker_prager_return<Dim>(elastic, dp, eps, kappa, old, nw, sigma, &sz, m);
+      }
+    } else
       w = drucker_prager_return<Dim>(elastic, dp, eps, kappa, old, nw, sigma, &sz, m);
     double tr = Dim == 2 ? nw.ezz : 0.0;
     for (int k = 0; k < Dim * Dim; ++k)
@@ -421,11 +460,28 @@ struct MicropolarDruckerPrager {
     return w;
   }
 
+  // Pi / biot of the header (plane stress with pore water; 0 otherwise): what the solver adds to
+  // tr eps for the water's volumetric strain, with the current plastic state (after the step's
+  // return) or the step's start state.
+  KOKKOS_INLINE_FUNCTION double pore_shift(std::size_t i) const {
+    return pore_water ? shift(vol(i), ezz(i)) : 0.0;
+  }
+  KOKKOS_INLINE_FUNCTION double pore_shift_start(std::size_t i) const {
+    if (!pore_water)
+      return 0.0;
+    const double tr = start(i, kEp) + start(i, kEp + Dim * Dim - 1) + start(i, kEzz);
+    return shift(tr, start(i, kEzz));
+  }
+  // (lambda tr eps^p + 2 mu eps^p_zz) / L divided by biot = 2 mu / L.
+  KOKKOS_INLINE_FUNCTION double shift(double tr_ep, double ep_zz) const {
+    return (elastic.lambda * tr_ep + 2 * elastic.mu * ep_zz) / (2 * elastic.mu);
+  }
+
   // Plastic dissipation of the step at point i per unit volume: the trapezoid
   // 1/2 (sigma_start + sigma) : d eps^p + 1/2 (m_start + m) : d kappa^p (3 x 3 with the zz
-  // terms in plane strain). With W quadratic in the elastic strain this is exactly the part of
-  // the trapezoid work 1/2 (sigma_start + sigma) : d eps that the stored energy does not take,
-  // so the energy balance (eq 140) closes with it.
+  // terms in 2D) of the effective stress sigma-bar. With W quadratic in the elastic strain this is
+  // exactly the part of the trapezoid work 1/2 (sigma_start + sigma) : d eps that the stored energy
+  // does not take, so the energy balance (eq 140) closes with it.
   template <class Stress>
   KOKKOS_INLINE_FUNCTION double dissipation(std::size_t i, const Stress& sigma,
                                             const Stress& m) const {
@@ -436,6 +492,12 @@ struct MicropolarDruckerPrager {
       d += 0.5 * (start(i, kSzz) + szz(i)) * (ezz(i) - start(i, kEzz));
     for (int k = 0; k < R * Dim; ++k)
       d += 0.5 * (start(i, kM + k) + m(i, k)) * (kp(i, k) - start(i, kKp + k));
+    if (pore_water) {  // sigma holds sigma-bar_in - (lambda / L) S_r p* 1 (stress()): add it back
+      const double c = elastic.lambda / (elastic.lambda + 2 * elastic.mu);
+      for (int a = 0; a < Dim; ++a)
+        d += 0.5 * c * (start(i, kSzz) + szz(i)) *
+             (ep(i, a * Dim + a) - start(i, kEp + a * Dim + a));
+    }
     return d;
   }
 

@@ -56,9 +56,8 @@ struct MicropolarElastic {
   // incompressible water and grains under an in-plane all-round pressure q take p = 2q/3 (not
   // q), and the one-dimensional consolidation modulus becomes lambda* + 2 mu with storage
   // phi/K_w + 1/(lambda + mu) (tests/solvers/test_fluid_solver.cpp, the plane-stress entries).
-  // Elastic only: a plastic law would have to return to sigma'_zz = S_r p and give the water its
-  // plastic eps_zz (not derived; src/input/input.cpp refuses Drucker-Prager with pore water in
-  // plane stress).
+  // Drucker-Prager returns to sigma'_zz = S_r p and gives the water its plastic thickness change
+  // on top of this coupling (include/mupm/laws/micropolar_drucker_prager.hpp).
   PoreCoupling plane_stress_coupling() const {
     return {2 * mu / (lambda + 2 * mu), 1 / (lambda + 2 * mu)};
   }
@@ -93,11 +92,16 @@ struct MicropolarElastic {
     return w;
   }
   // The law of pass 1 (include/mupm/kernels/solid.hpp): the same at every point.
+  // srp (S_r p*) is for the plastic law's plane stress; the elastic law's pore water is in
+  // PoreCoupling.
   template <int Dim>
   KOKKOS_INLINE_FUNCTION double stress(std::size_t /*i*/, const double* eps, const double* kappa,
-                                       double* sigma, double* m) const {
+                                       double* sigma, double* m, double /*srp*/ = 0) const {
     return stress<Dim>(eps, kappa, sigma, m);
   }
+  // The plastic law's shift of the water's volumetric strain (none here).
+  KOKKOS_INLINE_FUNCTION double pore_shift(std::size_t) const { return 0.0; }
+  KOKKOS_INLINE_FUNCTION double pore_shift_start(std::size_t) const { return 0.0; }
 };
 
 // Mixture density rho = (1 - phi) rho_s + S_r phi rho_w (eq 1).

@@ -806,12 +806,15 @@ class SolidSolver : public Mechanics, public Skeleton {
     forces_time_ = t;
     auto eps = st_.eps;
     auto vs = p.vol_strain;
+    const Law law = law_;
     Kokkos::parallel_for(
         "mupm::Solid::volumetric_strain", range(0, p.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-          double tr = 0;
+          // eq 117; plus the plastic thickness change in plane stress with pore water
+          // (laws/micropolar_drucker_prager.hpp, pore_shift; 0 otherwise)
+          double tr = law.pore_shift(i);
           for (int d = 0; d < Dim; ++d)
             tr += eps(i, d * Dim + d);
-          vs(i) = tr;  // eq 117
+          vs(i) = tr;
         });
   }
 
