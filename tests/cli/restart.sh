@@ -9,7 +9,7 @@
 # crack-water force models, and a mirrored Fracture Pressure on a layer the crack runs into:
 # restarted bit for bit on 2 ranks, and 1e-10 across rank and thread counts, the network's
 # distributed solve), whose water balance is checked too; and a Drucker-Prager soil
-# restarted as its shear bands soften.
+# restarted as its shear bands soften (in plane strain, and in plane stress with its water).
 #   restart.sh MUPM SRC WORK PYTHON MPIEXEC [CASE...]: only the cases named (all when none), so
 #   that ctest runs them as several entries (tests/CMakeLists.txt).
 source "$(dirname "$0")/common.sh"
@@ -157,6 +157,9 @@ check fracture-flow-mirrored tests/cli/fracture_small.xml 440 25 "s|value=\"\{-y
 # second-order work's window in the checkpoint.
 solve=0
 check plastic inputs/example3_biaxial.xml 7400 16 's|value="0.00166666666666667"/>|value="0.00625"/>|; s|value="\{60, 120\}"|value="{16, 32}"|; s|value="\{0.00166666666666667, 0.2\}"|value="{0.00625, 0.2}"|; s|value="\{0.0983333333333333, 0\}"|value="{0.09375, 0}"|; s|<Parameter name="Time Step" type="double" value="2.5e-6"/>|<Parameter name="Time Step" type="double" value="1.75e-5"/>|; s|<ParameterList name="Output">|<ParameterList name="Output"><Parameter name="Second-Order Work Window" type="int" value="100"/>|'
+# The same in plane stress with the pore water (the return to sigma'_zz = S_r p*, the plastic
+# thickness change in the water's volumetric strain: laws/micropolar_drucker_prager.hpp).
+check plastic-stress inputs/example3_biaxial.xml 7400 16 's|value="0.00166666666666667"/>|value="0.00625"/>|; s|value="\{60, 120\}"|value="{16, 32}"|; s|value="\{0.00166666666666667, 0.2\}"|value="{0.00625, 0.2}"|; s|value="\{0.0983333333333333, 0\}"|value="{0.09375, 0}"|; s|<Parameter name="Time Step" type="double" value="2.5e-6"/>|<Parameter name="Time Step" type="double" value="1.75e-5"/>|; s|<ParameterList name="Output">|<ParameterList name="Output"><Parameter name="Second-Order Work Window" type="int" value="100"/>|; s|<Parameter name="Dimension" type="int" value="2"/>|&<Parameter name="Plane" type="string" value="Stress"/>|'
 # The same with Automatic Time Step: the restart continues with the run's step (kept in the
 # checkpoint), not with an estimate of the restarted state, whose crack water is stiffer.
 solve=1

@@ -310,7 +310,11 @@ class SolidSolver : public Mechanics, public Skeleton {
     // of before the step's fluid update (Solid First), which the forces evaluated here no
     // longer have.
     st_.work = energy_criterion() && !restarted ? BondWork::Record : BondWork::Off;
-    forces(t);
+    // A restart's state holds the plastic state of the forces last applied (keeping_plastic_state).
+    if (restarted)
+      keeping_plastic_state([&] { forces(t); });
+    else
+      forces(t);
     // Points::solid_pressure is the p* of the forces last applied (the pore work of the next
     // step starts from it); a restart has it from the checkpoint, not from the pressure the
     // fluid has updated since.
@@ -595,7 +599,11 @@ class SolidSolver : public Mechanics, public Skeleton {
   // With a fluid the operator includes the undrained stiffness (biot S_r)^2 / C of the undrained
   // split (include/mupm/kernels/solid.hpp): the fastest waves are the undrained ones.
   bool limits_time_step() const override { return true; }
-  double stable_time_step() override { return estimate_stable_dt(); }
+  double stable_time_step() override {
+    double dt = 0;
+    keeping_plastic_state([&] { dt = estimate_stable_dt(); });
+    return dt;
+  }
   std::string describe() const override {
     std::ostringstream s;
     s << "micropolar solid, stabilization G = " << prm_.stabilization
@@ -915,6 +923,41 @@ class SolidSolver : public Mechanics, public Skeleton {
     const auto& g = disc_.grid;  // the real body's centre
     measure_bands(disc_.points, g.origin[0] + 0.5 * g.counts[0] * g.dx,
                   g.origin[1] + 0.5 * g.counts[1] * g.dx, sum, max, angle, width);
+  }
+
+  // Runs f, an evaluation between two steps (a restart's first, the stable-step estimate), and
+  // puts back the plastic law's current state: such an evaluation sees the pressure the fluid
+  // has updated since the step's forces, and where the return depends on it (plane stress with
+  // pore water, laws/micropolar_drucker_prager.hpp) it would change the state the next step
+  // commits (a restart then differed from the straight run by 1e-7 after one step).
+  template <class F>
+  void keeping_plastic_state(F&& f) {
+    std::vector<Vectors> kept;
+    if constexpr (Law::plastic)
+      for (const Vectors& v : plastic_current(disc_.points))
+        kept.push_back(copy_of(v));
+    f();
+    for (std::size_t k = 0; k < kept.size(); ++k)
+      Kokkos::deep_copy(plastic_current(disc_.points)[k], kept[k]);
+  }
+  // The fields the plastic law's return writes (its current state, the stress it commits, the
+  // water's volumetric strain).
+  static std::vector<Vectors> plastic_current(const Points<Dim>& p) {
+    return {p.stress,
+            p.couple_stress,
+            p.plastic_strain,
+            p.plastic_wryness,
+            as_vectors(p.plastic_strain_zz),
+            as_vectors(p.equivalent_plastic_strain),
+            as_vectors(p.plastic_volumetric_strain),
+            as_vectors(p.cohesion),
+            as_vectors(p.stress_zz),
+            as_vectors(p.vol_strain)};
+  }
+  static Vectors copy_of(const Vectors& f) {
+    Vectors c("mupm::kept", f.extent(0), f.extent(1));
+    Kokkos::deep_copy(c, f);
+    return c;
   }
 
   // The plastic law's current state becomes the start of the next step (the law's header).
