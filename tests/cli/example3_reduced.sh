@@ -24,7 +24,8 @@
 # field is symmetric about the vertical axis; the plastic zone crosses the whole width at
 # mid-height (sigma_zz = 0 is the largest principal stress under the lateral confinement, so the
 # band's plane contains the x axis and cuts through the thickness: in the plane it is a
-# horizontal zone, not the conjugate pair of plane strain); the solid's energy balance closes to
+# horizontal zone, not the conjugate pair of plane strain; at the full 60 x 120 the zones form
+# along the platens instead, inputs/README.md); the solid's energy balance closes to
 # 2e-3 of the external work (it does only with the plastic thickness change booked on both
 # sides: leaving it out of the dissipation's in-plane share or of the water's volumetric strain
 # left 3.4 J of 420 J), the water's to 1e-10 and its mass to round-off.
