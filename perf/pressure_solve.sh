@@ -3,13 +3,19 @@
 # include/mupm/solvers/pressure_projection.hpp): GMRES iterations per step, time per step of the
 # projection (its solve, its assembly) and its share of the whole step, from the run's kernel
 # timers (max over ranks) and time_series.csv, on 1 rank and on 2 ranks (1 thread each).
-#   perf/pressure_solve.sh MUPM [CASE...]   CASE: example1 | cube50 | cube100 (all by default)
+#   perf/pressure_solve.sh MUPM [CASE...]   CASE: example1 | cube50 | cube100 | crack | crack-kept
+#                                           | crack-whole (all by default)
 # example1: inputs/example1_deformation_driven.xml (Example 1 case 2, 100 x 100, delta = 3.015 dx)
 #   with incompressible water at the automatic (drained) step, 200 steps of the load's ramp.
 # cube50: a saturated 3D cube of 50^3 points, delta = 3.015 dx, incompressible, base fixed, top
 #   drained and pressed at 1 cm/s, 10 steps. cube100: the same at 100^3 = 1e6 points with
 #   delta = 1.5 dx (at 3.015 dx the projection's matrix, two horizons wide, would hold ~920
 #   entries a row: 11 GB at 1e6 points, and its ILU as much: beyond this machine's 24 GiB).
+# crack: inputs/example1_fluid_driven.xml (Example 1 case 1, 100 x 100, fracture flow: the crack
+#   water's pressure in the same solve, whose network rows change every step) with
+#   incompressible water at the automatic step, 150 steps, the default Pressure Solve; crack-kept:
+#   the same with Drop Tolerance = 0 (the ILU of the whole matrix); crack-whole: also Preconditioner
+#   Refresh Interval = 1 (that ILU computed every step, as before both settings existed).
 # Writes into a temporary folder; prints one table row per case and rank count.
 set -euo pipefail
 MUPM=$(realpath "$1")
@@ -17,7 +23,7 @@ shift
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 PY=/usr/bin/python3
 cases=("$@")
-((${#cases[@]})) || cases=(example1 cube50 cube100)
+((${#cases[@]})) || cases=(example1 cube50 cube100 crack crack-kept crack-whole)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
@@ -30,6 +36,15 @@ example1() {  # example1 FOLDER
     -e 's#name="(Field|Checkpoint) Interval" type="int" value="[0-9]+"#name="\1 Interval" type="int" value="0"#' \
     -e 's|name="Time Series Interval" type="int" value="[0-9]+"|name="Time Series Interval" type="int" value="1"|' \
     "$SRC/inputs/example1_deformation_driven.xml"
+}
+crack() {  # crack FOLDER DROP_TOLERANCE REFRESH_INTERVAL
+  sed -E -e "s|<Parameter name=\"Physics\" type=\"string\" value=\"Hydro-Mechanical\"/>|&<Parameter name=\"Pressure Integration\" type=\"string\" value=\"Semi-Implicit\"/><ParameterList name=\"Pressure Solve\"><Parameter name=\"Drop Tolerance\" type=\"double\" value=\"$2\"/><Parameter name=\"Preconditioner Refresh Interval\" type=\"int\" value=\"$3\"/></ParameterList>|" \
+    -e 's|(<Parameter name="Fluid Bulk Modulus"[^>]*>)|\1<Parameter name="Incompressible" type="bool" value="true"/>|' \
+    -e 's|<Parameter name="End Time" type="double" value="[^"]*"/>|<Parameter name="Number of Steps" type="int" value="150"/>|' \
+    -e "s|<Parameter name=\"Folder\" type=\"string\" value=\"[^\"]*\"/>|<Parameter name=\"Folder\" type=\"string\" value=\"$1\"/>|" \
+    -e 's#name="(Field|Checkpoint) Interval" type="int" value="[0-9]+"#name="\1 Interval" type="int" value="0"#' \
+    -e 's|name="Time Series Interval" type="int" value="[0-9]+"|name="Time Series Interval" type="int" value="1"|' \
+    "$SRC/inputs/example1_fluid_driven.xml"
 }
 cube() {  # cube FOLDER N HORIZON STEPS
   local fix="" comp
@@ -80,15 +95,19 @@ cube() {  # cube FOLDER N HORIZON STEPS
 XML
 }
 
-# it/step: Krylov iterations (CG, or GMRES with mirrored pressure layers); solve ms: the projection per step without its assembly (once per
-# run here: no bond breaks); rest ms: the rest of the step (solid, fluid, output); share: the
-# projection's part of the step without the assembly.
-printf '%-9s %5s %8s %5s %7s %9s %9s %10s %6s\n' case ranks points steps "it/step" "solve ms" "rest ms" "assemble s" share
+# it/step: Krylov iterations (CG, or GMRES with mirrored pressure layers); solve ms: the
+# projection per step without its assembly (once per run here: no bond breaks); rest ms: the
+# rest of the step (solid, fluid, output); share: the projection's part of the step without the
+# assembly.
+printf '%-11s %5s %8s %5s %7s %9s %9s %10s %6s\n' case ranks points steps "it/step" "solve ms" "rest ms" "assemble s" share
 for c in "${cases[@]}"; do
   case $c in
     example1) example1 "$c" >"$c.xml" ;;
     cube50) cube "$c" 50 3.015 10 >"$c.xml" ;;
     cube100) cube "$c" 100 1.5 5 >"$c.xml" ;;
+    crack) crack "$c" 0.02 20 >"$c.xml" ;;
+    crack-kept) crack "$c" 0 20 >"$c.xml" ;;
+    crack-whole) crack "$c" 0 1 >"$c.xml" ;;
     *) echo "unknown case $c" >&2; exit 1 ;;
   esac
   for np in 1 2; do
@@ -109,7 +128,7 @@ points = re.search(r"(\d+) points", out)
 rows = list(csv.DictReader(open(f"{name}/time_series.csv")))[1:]
 its = sum(float(r["pressure_solve_iterations"]) for r in rows) / max(1, len(rows))
 solve, rest = (proj - asm) / steps, (step - proj) / steps
-print("%-9s %5s %8s %5d %7.1f %9.1f %9.1f %10.2f %5.0f%%" % (
+print("%-11s %5s %8s %5d %7.1f %9.1f %9.1f %10.2f %5.0f%%" % (
     name, np_, points.group(1) if points else "?", steps, its, 1e3 * solve, 1e3 * rest, asm,
     100 * solve / (solve + rest)))
 PY

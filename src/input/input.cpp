@@ -517,6 +517,22 @@ RCP<ParameterList> valid_parameters() {
              "it, e.g. at a zero pivot, is repeated with Jacobi for that matrix), Jacobi or None.",
              one_of({"ILU", "Jacobi", "None"}));
       ps.set("ILU Fill Level", 0, "Level of fill k of ILU(k).", at_least(0));
+      ps.set("Drop Tolerance", 0.02,
+             "ILU: the factors are of the matrix without its entries |a_ij| < this x "
+             "sqrt(|a_ii a_jj|), each added to the diagonal (the preconditioner stays symmetric "
+             "positive definite; the solve is still of the whole matrix). The projection's "
+             "matrix is two horizons wide with small far entries: 0.02 keeps about a quarter "
+             "of them (an apply 3.6 times cheaper, 40 % more iterations, measured on Example 1 "
+             "case 1). 0: the whole matrix.",
+             rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1.0)));
+      ps.set("Preconditioner Refresh Interval", 20,
+             "With a fracture network the matrix's values change every step (the cubic law's "
+             "apertures): the preconditioner is computed again on every this-many-th change and "
+             "at the step after a checkpoint (so that a restart continues bit for bit), and kept "
+             "in between; the solve still reaches Tolerance on the current matrix, only its "
+             "iterations depend on it. 1: every step. A new matrix graph (bonds broken, points "
+             "joining the network) always computes it.",
+             at_least(1));
       ps.set("Tolerance", 1e-11,
              "Residual ||b - A x|| at which the solve stops, relative to the largest right-hand "
              "side ||b|| of the run so far (the water balances of a step): every point's water "

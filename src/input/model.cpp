@@ -357,6 +357,8 @@ Model<Dim> model_from_input(const ParameterList& input) {
     const ParameterList& ps = solver.sublist("Pressure Solve");
     r.pressure_solve.preconditioner = ps.get<std::string>("Preconditioner");
     r.pressure_solve.fill_level = ps.get<int>("ILU Fill Level");
+    r.pressure_solve.refresh_interval = ps.get<int>("Preconditioner Refresh Interval");
+    r.pressure_solve.drop_tolerance = ps.get<double>("Drop Tolerance");
     r.pressure_solve.tolerance = ps.get<double>("Tolerance");
     r.pressure_solve.max_iterations = ps.get<int>("Maximum Iterations");
   }

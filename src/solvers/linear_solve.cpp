@@ -6,6 +6,7 @@
 #include <Ifpack2_Factory.hpp>
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_ParameterList.hpp>
+#include <Tpetra_Import.hpp>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -34,12 +35,62 @@ bool fails_anywhere(const Teuchos::Comm<int>& comm, F&& f) {
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, failed, Teuchos::outArg(anywhere));
   return anywhere != 0;
 }
+
+// The preconditioner's matrix for a drop tolerance theta > 0 (LinearSolveSettings): A without
+// its entries |a_ij| < theta sqrt(|a_ii a_jj|), each dropped |a_ij| added to a_ii. The rule is
+// symmetric (a pair is dropped on both sides), and each dropped pair changes the matrix by
+// |a_ij| (e_i - s e_j)(e_i - s e_j)^T, s = sign(a_ij), positive semi-definite: P >= A, so P is
+// symmetric positive definite where A is (the preconditioner CG needs).
+Teuchos::RCP<CrsMatrix> sparsified(const CrsMatrix& a, double theta) {
+  TpetraVector d(a.getRowMap()), dc(a.getColMap());
+  a.getLocalDiagCopy(d);
+  Tpetra::Import<LocalId, GlobalId> imp(a.getRowMap(), a.getColMap());
+  dc.doImport(d, imp, Tpetra::INSERT);
+  const auto dv = d.getLocalViewHost(Tpetra::Access::ReadOnly);
+  const auto cv = dc.getLocalViewHost(Tpetra::Access::ReadOnly);
+  const auto l = a.getLocalMatrixHost();
+  const auto& rows = *a.getRowMap();
+  const auto& cols = *a.getColMap();
+  const LocalId n = LocalId(l.numRows());
+  std::vector<std::vector<LocalId>> keep(n);
+  std::vector<std::vector<double>> vals(n);
+  std::size_t longest = 1;
+  for (LocalId r = 0; r < n; ++r) {
+    const GlobalId g = rows.getGlobalElement(r);
+    double extra = 0;
+    std::size_t diag = std::size_t(-1);
+    for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q) {
+      const LocalId c = l.graph.entries(q);
+      const double v = l.values(q);
+      const bool is_diag = cols.getGlobalElement(c) == g;
+      if (is_diag || std::fabs(v) >= theta * std::sqrt(std::fabs(dv(r, 0) * cv(c, 0)))) {
+        if (is_diag)
+          diag = keep[r].size();
+        keep[r].push_back(c);
+        vals[r].push_back(v);
+      } else {
+        extra += std::fabs(v);
+      }
+    }
+    if (diag != std::size_t(-1))
+      vals[r][diag] += extra;
+    longest = std::max(longest, keep[r].size());
+  }
+  auto p = Teuchos::rcp(new CrsMatrix(a.getRowMap(), a.getColMap(), longest));
+  for (LocalId r = 0; r < n; ++r)
+    if (!keep[r].empty())
+      p->insertLocalValues(r, Teuchos::ArrayView<const LocalId>(keep[r]),
+                           Teuchos::ArrayView<const double>(vals[r]));
+  p->fillComplete(a.getDomainMap(), a.getRangeMap());
+  return p;
+}
 }  // namespace
 
 struct LinearSolve::Impl {
   Teuchos::RCP<Teuchos::ParameterList> params;
   Teuchos::RCP<const CrsMatrix> a;
   Teuchos::RCP<Preconditioner> prec;
+  Teuchos::RCP<const CrsMatrix> pm;  // the matrix prec was computed from
   Teuchos::RCP<Belos::LinearProblem<double, MV, OP>> problem;
   Teuchos::RCP<Belos::SolverManager<double, MV, OP>> solver;
 };
@@ -71,6 +122,10 @@ LinearSolve::LinearSolve(const LinearSolveSettings& settings)
 
 LinearSolve::~LinearSolve() = default;
 
+Teuchos::RCP<const CrsMatrix> LinearSolve::preconditioner_matrix() const {
+  return impl_->pm;
+}
+
 void LinearSolve::set_matrix(const Teuchos::RCP<const CrsMatrix>& a) {
   ScopedRegion region("mupm::LinearSolve::setup");
   impl_->a = a;
@@ -83,12 +138,19 @@ void LinearSolve::set_matrix(const Teuchos::RCP<const CrsMatrix>& a) {
   jacobi_ = set_.preconditioner == "Jacobi";
   precondition();
   ++setups_;
+  kept_ = 0;
+  renew_ = false;
 }
 
 void LinearSolve::refresh() {
   ScopedRegion region("mupm::LinearSolve::refresh");
   if (impl_->a.is_null())
     throw std::logic_error("LinearSolve::refresh before set_matrix");
+  // Kept factors: the same decision on every rank (the calls and renewals are collective).
+  if (!renew_ && ++kept_ < set_.refresh_interval)
+    return;
+  kept_ = 0;
+  renew_ = false;
   ++setups_;
   if (set_.preconditioner == "None")
     return;
@@ -101,12 +163,21 @@ void LinearSolve::refresh() {
     precondition();
     return;
   }
-  if (!fails_anywhere(*impl_->a->getComm(), [&] { impl_->prec->compute(); }))
+  compute_factors();
+}
+
+// The ILU of the current values: the numeric part again on the kept symbolic one, or (with a
+// drop tolerance, whose pattern follows the values) the whole set-up. An ILU whose factorization
+// throws: Jacobi for these values at once, as precondition() does.
+void LinearSolve::compute_factors() {
+  if (set_.drop_tolerance > 0) {
+    precondition();
     return;
-  // An ILU whose factorization throws: Jacobi for these values at once, as precondition() does
-  // (trying the ILU again there would only fail again).
-  fall_back_to_jacobi();
-  precondition();
+  }
+  if (fails_anywhere(*impl_->a->getComm(), [&] { impl_->prec->compute(); })) {
+    fall_back_to_jacobi();
+    precondition();
+  }
 }
 
 void LinearSolve::fall_back_to_jacobi() {
@@ -120,6 +191,7 @@ void LinearSolve::fall_back_to_jacobi() {
 // An ILU whose factorization throws (a zero pivot caught by Ifpack2) falls back at once.
 void LinearSolve::precondition() {
   impl_->prec = Teuchos::null;
+  impl_->pm = Teuchos::null;
   if (set_.preconditioner == "None") {
     impl_->problem->setRightPrec(Teuchos::null);
     return;
@@ -136,7 +208,10 @@ void LinearSolve::precondition() {
       p.set("relaxation: type", "Jacobi");
       p.set("relaxation: sweeps", 1);
     }
-    Teuchos::RCP<const RowMatrix> rows = impl_->a;
+    impl_->pm = impl_->a;
+    if (set_.drop_tolerance > 0 && !jacobi_)
+      impl_->pm = sparsified(*impl_->a, set_.drop_tolerance);
+    Teuchos::RCP<const RowMatrix> rows = impl_->pm;
     if (!fails_anywhere(*impl_->a->getComm(), [&] {
           impl_->prec = Ifpack2::Factory::create<RowMatrix>(jacobi_ ? "RELAXATION" : "RILUK", rows);
           impl_->prec->setParameters(p);
@@ -179,8 +254,9 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
   // pivot on a matrix that is not an M-matrix (the projection's, measured on Example 1 case 2
   // once the crack grew); KokkosKernels' factorization then puts 1e-6 in its place, a
   // preconditioner that stalls the solve or turns its residual NaN. A solve that fails with
-  // ILU is therefore tried again from the same initial guess with Jacobi, kept for this
-  // matrix's values. Otherwise a failed solve, for the caller to report.
+  // ILU is therefore tried again from the same initial guess: with the ILU of this matrix's
+  // values where the factors were of earlier ones (refresh_interval), else with Jacobi, kept
+  // for this matrix's values. Otherwise a failed solve, for the caller to report.
   TpetraVector x0(x, Teuchos::Copy);
   for (;;) {
     impl_->solver->setProblem(impl_->problem);
@@ -195,9 +271,16 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
     }
     if (r.converged || jacobi_ || set_.preconditioner != "ILU")
       return r;
-    jacobi_ = true;
-    ++fallbacks_;
-    precondition();
+    if (kept_ > 0) {
+      // Factors of earlier values (refresh_interval): first the ILU of these values.
+      kept_ = 0;
+      ++setups_;
+      compute_factors();
+    } else {
+      jacobi_ = true;
+      ++fallbacks_;
+      precondition();
+    }
     x.assign(x0);
     if (!impl_->problem->setProblem())
       throw std::logic_error("LinearSolve: Belos could not set up the problem");

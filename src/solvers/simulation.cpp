@@ -546,7 +546,11 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
         << " Pa, flow stabilization G = " << f.stabilization
         << ", pressure stabilization G_p = " << f.projection_stabilization
         << "; one solve per step (" << ph.fluid->pressure_solve_method() << ", "
-        << ls.preconditioner << ", tolerance " << ls.tolerance << ")\n";
+        << ls.preconditioner;
+    if (ls.preconditioner == "ILU")
+      out << "(" << ls.fill_level << ") of the matrix less its entries below " << ls.drop_tolerance
+          << " of the diagonals' geometric mean, kept up to " << ls.refresh_interval << " steps";
+    out << ", tolerance " << ls.tolerance << ")\n";
   }
   if (ph.fluid && !ph.fluid->semi_implicit()) {
     auto& fluid = *ph.fluid;
@@ -982,6 +986,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
   const std::string checkpoint_path = run.folder + "/checkpoint.h5";
   auto checkpoint = [&] {
     write_checkpoint(checkpoint_path, disc, step, time, fields.history(), ph.globals(), run.fixed);
+    for (Module* m : ph.modules())
+      m->checkpointed();
   };
   if (!restarted) {
     fields.write(step, time);

@@ -54,8 +54,9 @@ if [[ $plane == stress ]]; then
   sed -i 's|<Parameter name="Dimension" type="int" value="2"/>|&<Parameter name="Plane" type="string" value="Stress"/>|' psi35.xml
   grep -qF 'value="Stress"' psi35.xml || fail "psi35.xml: no Dimension to add Plane = Stress to"
   run 2 1 psi35.xml >psi35.out
-  "$PYTHON" - <<'PY'
+  PYTHONPATH="$SRC/tests/cli" "$PYTHON" - <<'PY'
 import csv, h5py, numpy as np
+from example3_checks import mirror_asymmetry
 rows = list(csv.DictReader(open("out35/time_series.csv")))
 R = np.array([-float(r["reaction_top"]) for r in rows])
 peak = R.argmax()
@@ -64,9 +65,7 @@ x = h5py.File("out35/mesh.h5")["coordinates"][...]
 f = h5py.File("out35/fields_%09d.h5" % 4000)
 e = f["equivalent_plastic_strain"][...]
 body = (x[:, 1] > 0) & (x[:, 1] < 0.2)
-key = {(round(a * 1e7), round(b * 1e7)): i for i, (a, b) in enumerate(x)}
-mirror = np.array([key[(round((0.1 - a) * 1e7), round(b * 1e7))] for a, b in x])
-asym = np.abs(e - e[mirror]).max() / e.max()
+asym = mirror_asymmetry(x, e)
 assert asym < 1e-8, ("not symmetric about the vertical axis", asym)
 loc = body & (e >= 0.5 * e.max())
 dx = 0.1 / 24
@@ -98,8 +97,9 @@ for psi in 35 15; do
   reduced $psi
   run 2 1 psi$psi.xml >psi$psi.out
 done
-"$PYTHON" - <<'PY'
+PYTHONPATH="$SRC/tests/cli" "$PYTHON" - <<'PY'
 import csv, math, h5py, numpy as np
+from example3_checks import mirror_asymmetry
 angle = {}
 for psi in (35, 15):
     rows = list(csv.DictReader(open("out%d/time_series.csv" % psi)))
@@ -115,9 +115,7 @@ for psi in (35, 15):
     e = f["equivalent_plastic_strain"][...]
     d2 = f["second_order_work"][...]
     body = (x[:, 1] > 0) & (x[:, 1] < 0.2)
-    key = {(round(a * 1e7), round(b * 1e7)): i for i, (a, b) in enumerate(x)}
-    mirror = np.array([key[(round((0.1 - a) * 1e7), round(b * 1e7))] for a, b in x])
-    asym = np.abs(e - e[mirror]).max() / e.max()
+    asym = mirror_asymmetry(x, e)
     assert asym < 1e-8, ("not symmetric about the vertical axis", asym)
     xc = x[body][np.argmax(e[body])]
     dx = 0.1 / 24

@@ -29,6 +29,22 @@ DruckerPragerParams example3(double psi_deg = 35) {
   return d;
 }
 
+// A root of f by secant steps from e0, the first with the slope `slope`, until |f| <= tol (at
+// most 100 steps); `residual` gets f at the root returned.
+template <class F>
+double secant_root(F&& f, double e0, double slope, double tol, double& residual) {
+  double g0 = f(e0), e1 = e0 - g0 / slope, g1 = f(e1);
+  for (int it = 0; it < 100 && std::fabs(g1) > tol; ++it) {
+    const double e2 = g1 != g0 ? e1 - g1 * (e1 - e0) / (g1 - g0) : e1;
+    e0 = e1;
+    g0 = g1;
+    e1 = e2;
+    g1 = f(e1);
+  }
+  residual = g1;
+  return e1;
+}
+
 // Constants of eqs 89-91, written out again (not through the law's own functions).
 struct Consts {
   double a1, a3, k;
@@ -398,16 +414,9 @@ TEST(PlasticityDruckerPrager, PlaneStressUniaxialYieldStress) {
             drucker_prager_return<2>(el, dp, eps, kap, old, nw, sig, &szz, m);
           return sig[3];
         };
-        double e0 = eyy, g0 = syy(e0), e1 = e0 - g0 / E, g1 = syy(e1);
-        for (int it = 0; it < 100 && std::fabs(g1) > 1e-10 * std::fabs(yield); ++it) {
-          const double e2 = g1 != g0 ? e1 - g1 * (e1 - e0) / (g1 - g0) : e1;
-          e0 = e1;
-          g0 = g1;
-          e1 = e2;
-          g1 = syy(e1);
-        }
+        double g1 = 0;
+        eyy = secant_root(syy, eyy, E, 1e-10 * std::fabs(yield), g1);
         ASSERT_LT(std::fabs(g1), 1e-9 * std::fabs(yield));
-        eyy = e1;
         old = nw;
         if (plane_stress) {
           EXPECT_LT(std::fabs(szz), 1e-9 * std::fabs(yield));
@@ -468,16 +477,9 @@ TEST(PlasticityDruckerPrager, PlaneStressPoreWaterUniaxialYieldStress) {
           return sig[3] - s;
         };
         // eps_yy of the uniform swelling s / (3K) as the start, then secant steps.
-        double e0 = k == 1 ? s / (3 * K) : eyy, g0 = syy(e0), e1 = e0 - g0 / E, g1 = syy(e1);
-        for (int it = 0; it < 100 && std::fabs(g1) > 1e-10 * std::fabs(yield); ++it) {
-          const double e2 = g1 != g0 ? e1 - g1 * (e1 - e0) / (g1 - g0) : e1;
-          e0 = e1;
-          g0 = g1;
-          e1 = e2;
-          g1 = syy(e1);
-        }
+        double g1 = 0;
+        eyy = secant_root(syy, k == 1 ? s / (3 * K) : eyy, E, 1e-10 * std::fabs(yield), g1);
         ASSERT_LT(std::fabs(g1), 1e-9 * std::fabs(yield));
-        eyy = e1;
         old = nw;
         EXPECT_LT(std::fabs(szz - s), 1e-9 * std::fabs(yield));  // the total sigma_zz = 0
       }

@@ -294,6 +294,129 @@ TEST(PressureProjection, CheckerboardIsHeldByThePressureStabilization3D) {
   check_checkerboard<3>();
 }
 
+// The pressure solve's preconditioner (include/mupm/solvers/linear_solve.hpp) on the semi-
+// implicit step's matrix for incompressible water in a tight soil (pressure_projection.hpp),
+// A = dt^2 B~ M^-1 B~^T + dt V H (k = 0: the pressure stabilization alone) + V C (C a small
+// storage), 2D, delta = 3.015 dx: two horizons wide, on 1 and 2 ranks:
+//  - Drop Tolerance: the ILU's matrix P keeps under half of A's entries, and P - A is positive
+//    semi-definite (each dropped |a_ij| on the diagonal: x^T (P - A) x = sum |a_ij| (x_i -+
+//    x_j)^2 >= 0; leaving the dropped entries out, or adding them signed, makes it indefinite);
+//    CG with ILU(0) of P solves A x = b to the tolerance, checked with ||b - A x|| computed here;
+//  - Preconditioner Refresh Interval = 3: refresh() computes the factors on every third call,
+//    and at once after renew(); with factors of earlier values the solve still reaches the
+//    tolerance on the current matrix.
+TEST(PressureProjectionSolve, SparsifiedAndKeptPreconditionerSolveTheWholeMatrix) {
+  const auto law = MicropolarElastic::from_bulk_shear(10e6, 6e6, 3e6, 0.01);
+  const double rho = 1900, dt = 3e-6;
+  test::Body<2> body(test::box<2>({24, 24}, 3.015), law, 0.5, StabilizationModulus::Automatic, rho);
+  auto& disc = body.disc;
+  auto& p = disc.points;
+  Kokkos::deep_copy(p.saturation, 1.0);
+  const auto B = assemble_volume_coupling(disc);
+  const auto dofs = component_map(disc, 3, false);
+  TpetraVector minv(dofs);
+  {
+    const double J = micro_inertia(0.2, rho, 0.01);
+    auto v = minv.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < p.n_owned; ++i)
+      for (int k = 0; k < 3; ++k)
+        v(i * 3 + k, 0) = 1.0 / (p.volume(i) * (k < 2 ? rho : J));
+  }
+  auto fp = fluid_params(disc.grid, 0.0, 0.5);
+  fp.projection_stabilization = 1.0;
+  Scalars alpha("alpha", p.size()), density("rho", p.n_owned);
+  Kokkos::deep_copy(density, rho);
+  add_pressure_stabilization(disc, fp, dt, density, alpha);
+  auto a = Tpetra::MatrixMatrix::add(dt * dt, false, *projection_operator(*B, minv), dt, false,
+                                     *assemble_flow_operator(disc, fp, alpha));
+  const auto& owned = disc.dist.owned_map();
+  // s: 1e-3 of the mean diagonal, added in place (the graph has the diagonal).
+  auto add_to_diagonal = [&](double s) {
+    const auto l = a->getLocalMatrixHost();
+    const auto v = a->getLocalValuesView();
+    for (LocalId r = 0; r < LocalId(l.numRows()); ++r)
+      for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q)
+        if (a->getColMap()->getGlobalElement(l.graph.entries(q)) == owned->getGlobalElement(r))
+          v(q) += s * (1 + 0.5 * std::sin(double(owned->getGlobalElement(r))));
+  };
+  TpetraVector d(owned);
+  a->getLocalDiagCopy(d);
+  add_to_diagonal(1e-3 * d.norm1() / double(owned->getGlobalNumElements()));
+  LinearSolveSettings set;
+  set.method = "CG";
+  set.tolerance = 1e-10;
+  set.drop_tolerance = 0.02;
+  set.refresh_interval = 3;
+  LinearSolve solve(set);
+  solve.set_matrix(a);
+  const auto pm = solve.preconditioner_matrix();
+  ASSERT_FALSE(pm.is_null());
+  const double kept = double(pm->getGlobalNumEntries()) / double(a->getGlobalNumEntries());
+  EXPECT_LT(kept, 0.5);
+  // x^T (P - A) x >= 0 for fields of every roughness (the same on any rank count).
+  double worst = 0, scale = 0;
+  for (int k = 0; k < 12; ++k) {
+    TpetraVector x(owned), ax(owned), px(owned);
+    {
+      auto v = x.getLocalViewHost(Tpetra::Access::OverwriteAll);
+      for (std::size_t i = 0; i < p.n_owned; ++i) {
+        const double g = double(p.gid(i));
+        v(i, 0) = std::sin((k + 1) * 0.37 * g + k) + (k % 3 == 0 ? std::cos(2.9 * g) : 0.0);
+      }
+    }
+    a->apply(x, ax);
+    pm->apply(x, px);
+    const double xa = x.dot(ax), xp = x.dot(px);
+    scale = std::max(scale, xa);
+    worst = std::min(worst, xp - xa);
+  }
+  if (test::world()->getRank() == 0)
+    std::printf(
+        "[ drop 0.02 ] the ILU's matrix keeps %.3f of the entries; min x^T (P - A) x = "
+        "%.2e of x^T A x up to %.2e\n",
+        kept, worst, scale);
+  EXPECT_GE(worst, -1e-12 * scale);
+  // Solves against x = the smooth field, b = A x, computed here.
+  auto check_solve = [&](const char* what) {
+    TpetraVector exact(owned), b(owned), x(owned), r(owned);
+    {
+      auto v = exact.getLocalViewHost(Tpetra::Access::OverwriteAll);
+      for (std::size_t i = 0; i < p.n_owned; ++i) {
+        const double xi[3] = {p.x(i, 0), p.x(i, 1), 0};
+        v(i, 0) = field(xi, 0);
+      }
+    }
+    a->apply(exact, b);
+    x.putScalar(0.0);
+    double sc = 0;
+    const auto res = solve.solve(b, x, sc);
+    a->apply(x, r);
+    r.update(1.0, b, -1.0);
+    const double rel = r.norm2() / b.norm2();
+    if (test::world()->getRank() == 0)
+      std::printf("[ %s ] %d CG iterations, ||b - A x|| / ||b|| = %.2e\n", what, res.iterations,
+                  rel);
+    EXPECT_TRUE(res.converged) << what;
+    EXPECT_LT(rel, 2e-10) << what;
+  };
+  check_solve("ILU(0) of the sparsified matrix");
+  // Refreshes: the factors on every third call, and at once after renew().
+  const long long s0 = solve.setups();
+  std::vector<long long> computed;
+  for (int call = 1; call <= 7; ++call) {
+    add_to_diagonal(0.3 * d.norm1() / double(owned->getGlobalNumElements()));
+    if (call == 5)
+      solve.renew();
+    solve.refresh();
+    computed.push_back(solve.setups() - s0);
+    if (call == 2)
+      check_solve("factors of values two refreshes old");
+  }
+  // calls 1, 2 kept; 3 computes; 4 kept; 5 renewed; 6 kept; 7 kept (the count restarts at 5)
+  EXPECT_EQ(computed, (std::vector<long long>{0, 0, 1, 1, 2, 2, 2}));
+  check_solve("after the refreshes");
+}
+
 // An ILU(0) breakdown of the pressure solve (include/mupm/solvers/linear_solve.hpp): blocks
 // [[1,1,0],[1,1,1],[0,1,1]], nonsingular with a unit diagonal, whose factorization without
 // pivoting meets a zero pivot in its second row (1 - 1 * 1), one block per rank on 2 ranks. The

@@ -287,6 +287,13 @@ class FluidSolver : public Module {
     evaluate();
   }
 
+  // The semi-implicit pressure solve's kept preconditioner is computed again at the next step
+  // (LinearSolve::renew), as a restart from this checkpoint computes it.
+  void checkpointed() override {
+    if (projection_)
+      projection_->renew_preconditioner();
+  }
+
   // The bond set changed (fracture): the flow of the current pressure again.
   void bonds_changed() {
     evaluate();

@@ -74,6 +74,9 @@ class Module {
   virtual void globals(GlobalRefs&) {}
   // Energy balances to check after each step (collective).
   virtual std::vector<EnergyBalance> energy_balances() const { return {}; }
+  // A checkpoint of this step was written: state that is not in it (a kept preconditioner) is
+  // renewed before the next step, as a restart from it builds it anew (collective).
+  virtual void checkpointed() {}
 };
 
 // What advances u and theta in a step (the micropolar solid, or kinematics alone).

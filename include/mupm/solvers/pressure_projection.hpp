@@ -130,8 +130,9 @@
 // opening when its bonds break enters the next step's balance); the correction's work on the
 // faces is part of projection_work. The network's rows change every step (apertures set
 // Lambda): with a network their values are added to the kept rest in place on a kept graph, and
-// the preconditioner's numeric part is computed again (compose); the joint map changes when
-// points join, or B_f when bonds break: then everything is assembled again. Measured
+// the preconditioner's factors are computed again every Preconditioner Refresh Interval steps
+// and after each checkpoint, kept in between (compose, LinearSolve::refresh); the joint map
+// changes when points join, or B_f when bonds break: then everything is assembled again. Measured
 // (tests/solvers/test_fracture_flow.cpp, FractureFlowSemiImplicit): incompressible water injected
 // into a free slot opens it by the injected volume to 1e-10 at the drained step; against the
 // explicit scheme on Example 1 case 1 at 66 x 66 (K_w = 2.2 GPa, a_min = 0.1 mm, the first 20 us):
@@ -143,7 +144,8 @@
 // The matrix and its preconditioner are kept while the bonds, the time step, the saturation,
 // the relative permeability and the densities are unchanged (a saturated run without breakage
 // assembles once). The solve is CG where A is symmetric (no image points; krylov below),
-// GMRES otherwise, each with ILU(k) (include/mupm/solvers/linear_solve.hpp).
+// GMRES otherwise, each with ILU(k) of A less its small (far) entries: Pressure Solve's Drop
+// Tolerance (include/mupm/solvers/linear_solve.hpp).
 #ifndef MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 #define MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 
@@ -186,6 +188,9 @@ class PressureProjection {
   const std::string& method() const { return solver_.settings().method; }
   // The bonds changed: assemble again before the next solve.
   void invalidate() { stale_ = true; }
+  // A checkpoint was written: the next step computes the preconditioner's factors, as a
+  // restart from it does (LinearSolve::renew).
+  void renew_preconditioner() { solver_.renew(); }
   long long assemblies() const { return assemblies_; }
 
   struct Result {
@@ -379,7 +384,7 @@ class PressureProjection {
   // ns's pattern and composed_ do not change: the values are written in place (composed_'s,
   // then ns's added: the same sums on every step, whether the graph is new or kept, so a
   // restart, which builds it again, gives the same matrix) and the preconditioner's numeric
-  // part alone is computed again (LinearSolve::refresh).
+  // part alone is computed again when the refresh interval is up (LinearSolve::refresh).
   void compose(const CrsMatrix& ns) {
     ScopedRegion region("mupm::Pressure::compose");
     const auto nl = ns.getLocalMatrixHost();
