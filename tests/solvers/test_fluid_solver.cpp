@@ -596,14 +596,16 @@ Terzaghi semi_implicit_column(double Kw, int N, double transits) {
   return column(N, transits, tz);
 }
 
-// Mirrored drained layers, at half the drained skeleton's step, with the explicit tests' water
-// (K_w / phi = 10 M, whose explicit step is sqrt(11) = 3.3 times shorter than the drained one),
-// real water (K_w = 2.2 GPa: K_w / phi = 400 M, 20 times shorter) and incompressible water:
-// max |p - p_cf| / p0 within 1 % at T_v = 0.2 and 0.5 beyond the first 2 dx, as the explicit
-// runs reach. (Without the pressure stabilization the stiff and incompressible columns grew
-// without bound: their images answered the checkerboard modes, pressure_projection.hpp.)
+// Mirrored drained layers, at half the drained skeleton's step, with real water (K_w = 2.2 GPa:
+// K_w / phi = 400 M, whose explicit step is 20 times shorter than the drained one) and
+// incompressible water: max |p - p_cf| / p0 within 1 % at T_v = 0.2 and 0.5 beyond the first
+// 2 dx, as the explicit runs reach. (Without the pressure stabilization these columns grew
+// without bound: their images answered the checkerboard modes, pressure_projection.hpp.) The
+// explicit tests' softer water (K_w / phi = 10 M: a storage of the skeleton's order) runs
+// semi-implicit in FluidSolverSemiImplicit.AgreesWithExplicitAsDtShrinks (fast tier); its
+// 500-transit column here (~60 s) was left out to keep .ci/run within its 40 minutes.
 TEST(FluidSolverSemiImplicitLong, TerzaghiSemiImplicitMirrored) {
-  for (const double Kw : {Terzaghi().Kw, 2.2e9, std::numeric_limits<double>::infinity()}) {
+  for (const double Kw : {2.2e9, std::numeric_limits<double>::infinity()}) {
     SCOPED_TRACE("K_w = " + std::to_string(Kw));
     if (test::world()->getRank() == 0)
       std::printf("[ terzaghi ] K_w = %g Pa\n", Kw);
