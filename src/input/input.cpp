@@ -514,7 +514,8 @@ RCP<ParameterList> valid_parameters() {
           "distributed over the ranks like the points.");
       ps.set("Preconditioner", std::string("ILU"),
              "Ifpack2's preconditioner: ILU (RILUK on each rank's rows; a solve that fails with "
-             "it, e.g. at a zero pivot, is repeated with Jacobi for that matrix), Jacobi or None.",
+             "it, e.g. at a zero pivot, is repeated with the ILU of the current values if it was "
+             "kept from earlier ones, then with Jacobi for that matrix), Jacobi or None.",
              one_of({"ILU", "Jacobi", "None"}));
       ps.set("ILU Fill Level", 0, "Level of fill k of ILU(k).", at_least(0));
       ps.set("Drop Tolerance", 0.02,
