@@ -28,23 +28,27 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
 
+# The edits both 2D cases make: incompressible water, FOLDER, no field or checkpoint output, a
+# time-series row every step.
+shared_edits() {  # shared_edits FOLDER: sed arguments
+  printf '%s\n' -e 's|(<Parameter name="Fluid Bulk Modulus"[^>]*>)|\1<Parameter name="Incompressible" type="bool" value="true"/>|' \
+    -e "s|<Parameter name=\"Folder\" type=\"string\" value=\"[^\"]*\"/>|<Parameter name=\"Folder\" type=\"string\" value=\"$1\"/>|" \
+    -e 's#name="(Field|Checkpoint) Interval" type="int" value="[0-9]+"#name="\1 Interval" type="int" value="0"#' \
+    -e 's|name="Time Series Interval" type="int" value="[0-9]+"|name="Time Series Interval" type="int" value="1"|'
+}
 example1() {  # example1 FOLDER
+  local shared
+  mapfile -t shared < <(shared_edits "$1")
   sed -E -e 's|<Parameter name="Time Step" type="double" value="[^"]*"/>|<Parameter name="Automatic Time Step" type="bool" value="true"/><Parameter name="Pressure Integration" type="string" value="Semi-Implicit"/>|' \
     -e 's|<Parameter name="Number of Steps" type="int" value="[0-9]+"/>|<Parameter name="Number of Steps" type="int" value="200"/>|' \
-    -e 's|(<Parameter name="Fluid Bulk Modulus"[^>]*>)|\1<Parameter name="Incompressible" type="bool" value="true"/>|' \
-    -e "s|<Parameter name=\"Folder\" type=\"string\" value=\"[^\"]*\"/>|<Parameter name=\"Folder\" type=\"string\" value=\"$1\"/>|" \
-    -e 's#name="(Field|Checkpoint) Interval" type="int" value="[0-9]+"#name="\1 Interval" type="int" value="0"#' \
-    -e 's|name="Time Series Interval" type="int" value="[0-9]+"|name="Time Series Interval" type="int" value="1"|' \
-    "$SRC/inputs/example1_deformation_driven.xml"
+    "${shared[@]}" "$SRC/inputs/example1_deformation_driven.xml"
 }
 crack() {  # crack FOLDER DROP_TOLERANCE REFRESH_INTERVAL
+  local shared
+  mapfile -t shared < <(shared_edits "$1")
   sed -E -e "s|<Parameter name=\"Physics\" type=\"string\" value=\"Hydro-Mechanical\"/>|&<Parameter name=\"Pressure Integration\" type=\"string\" value=\"Semi-Implicit\"/><ParameterList name=\"Pressure Solve\"><Parameter name=\"Drop Tolerance\" type=\"double\" value=\"$2\"/><Parameter name=\"Preconditioner Refresh Interval\" type=\"int\" value=\"$3\"/></ParameterList>|" \
-    -e 's|(<Parameter name="Fluid Bulk Modulus"[^>]*>)|\1<Parameter name="Incompressible" type="bool" value="true"/>|' \
     -e 's|<Parameter name="End Time" type="double" value="[^"]*"/>|<Parameter name="Number of Steps" type="int" value="150"/>|' \
-    -e "s|<Parameter name=\"Folder\" type=\"string\" value=\"[^\"]*\"/>|<Parameter name=\"Folder\" type=\"string\" value=\"$1\"/>|" \
-    -e 's#name="(Field|Checkpoint) Interval" type="int" value="[0-9]+"#name="\1 Interval" type="int" value="0"#' \
-    -e 's|name="Time Series Interval" type="int" value="[0-9]+"|name="Time Series Interval" type="int" value="1"|' \
-    "$SRC/inputs/example1_fluid_driven.xml"
+    "${shared[@]}" "$SRC/inputs/example1_fluid_driven.xml"
 }
 cube() {  # cube FOLDER N HORIZON STEPS
   local fix="" comp

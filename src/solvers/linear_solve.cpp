@@ -277,8 +277,7 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
       ++setups_;
       compute_factors();
     } else {
-      jacobi_ = true;
-      ++fallbacks_;
+      fall_back_to_jacobi();
       precondition();
     }
     x.assign(x0);
