@@ -228,8 +228,9 @@ RCP<ParameterList> valid_parameters() {
           "include/mupm/laws/micropolar_drucker_prager.hpp), for Solver->Physics = Micropolar "
           "Solid or Hydro-Mechanical (with Fracture->Fracture Flow the crack water pushes the "
           "faces in the plane, include/mupm/solvers/fracture_flow.hpp; Drucker-Prager with pore "
-          "water returns to sigma'_zz = S_r p and gives the water its plastic thickness change, "
-          "with Pressure Integration = Explicit only).",
+          "water returns to sigma'_zz = S_r p and gives the water its plastic thickness change; "
+          "with Pressure Integration = Semi-Implicit a step late, "
+          "include/mupm/solvers/fluid_solver.hpp, lagged_plastic_source).",
           plane_options().validator());
     d.set("Boundary Layer Horizons", 2.0,
           "Thickness of each boundary layer in horizons: floor(value * delta / dx) rows. 2 (the "
@@ -1075,20 +1076,6 @@ void check_dimension_arrays(ParameterList& input) {
       throw InputError("Error, " + path_of(disc, "Plane") +
                        " = Stress needs a skeleton (Solver->Physics = " + physics +
                        " has none): use Plane = Strain.");
-    const ParameterList& materials = input.sublist("Materials");
-    const ParameterList& solver = input.sublist("Solver");
-    if (has_fluid(phys) &&
-        constitutive_model_options()(materials.get<std::string>("Model")) ==
-            ConstitutiveModel::MicropolarDruckerPrager &&
-        pressure_integration_options()(solver.get<std::string>("Pressure Integration")) ==
-            PressureIntegration::SemiImplicit)
-      throw InputError(
-          "Error, " + path_of(disc, "Plane") + " = Stress is not implemented with " +
-          path_of(materials, "Model") + " = " + materials.get<std::string>("Model") + " and " +
-          path_of(solver, "Pressure Integration") + " = " +
-          solver.get<std::string>("Pressure Integration") +
-          " (the projection's water balance would need the plastic thickness change, which the "
-          "explicit scheme books): use Pressure Integration = Explicit, or Plane = Strain.");
   }
   if (has_solid(phys)) {
     const ParameterList& m = input.sublist("Materials");

@@ -346,9 +346,11 @@ class FluidSolver : public Module {
     CrackBlock crack;  // the fracture network's rows (fracture_flow.hpp), empty without one
     if (fracture_)
       fracture_->implicit_rows(t, dt, projection_->crack_offset(), crack);
+    const SkeletonState skel = skeleton.skeleton_state();
+    const Scalars source = lagged_plastic_source(dt, skel.plastic_shift);
     std::vector<double> dpf;
-    const auto r = projection_->step(dt, prm_, st_, source_, target, skeleton.skeleton_state(), dp_,
-                                     solve_scale_, crack, dpf);
+    const auto r =
+        projection_->step(dt, prm_, st_, source, target, skel, dp_, solve_scale_, crack, dpf);
     stats_ = {double(r.iterations), r.residual, double(projection_->assemblies())};
     if (!r.converged) {
       std::ostringstream m;
@@ -392,6 +394,8 @@ class FluidSolver : public Module {
     auto vs = p.vol_strain, ref = p.vol_strain_ref;
     auto fixed = p.fixed;
     auto C = c_old_, sr = sr_old_, f0 = flow_old_, hdp = hdp_, ddp = dp_, src = source_;
+    auto lag = lag_, now = shift_;
+    const bool lagged = shift_.extent(0) > 0;
     const VanGenuchten vg = prm_.retention;
     const double inv_kw = 1.0 / prm_.bulk_modulus;
     const double biot = prm_.pore.biot, cz = prm_.pore.lateral_compliance;
@@ -399,7 +403,10 @@ class FluidSolver : public Module {
     Kokkos::parallel_reduce(
         "mupm::Fluid::book_projection", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& wc, double& wd, double& we) {
-          const double dv = vs(i) - ref(i), dp = ddp(i), p0 = pw(i) - dp;
+          // the skeleton's volume change, with the plastic thickness change a step late
+          // (lagged_plastic_source)
+          const double dv = vs(i) - ref(i) + (lagged ? lag(i) - now(i) : 0.0);
+          const double dp = ddp(i), p0 = pw(i) - dp;
           const double flow = f0(i) + hdp(i) / vol(i);  // div(p_n) + H dp: backward Euler's
           const double rhs = -biot * sr(i) * dv + dt * (src(i) - flow);
           const bool held = fixed(i) & kFixedPressure;
@@ -416,6 +423,32 @@ class FluidSolver : public Module {
         w[0], w[1], w[2]);
     book(target, w);
     reset_strain_reference();
+  }
+
+  // The source the projection solves with: source_ itself, or in plane stress with plastic pore
+  // water (SkeletonState::plastic_shift) source_ - biot S_r lag / dt with lag the plastic
+  // thickness change of the previous step. The return that gives a step's change needs p_{n+1}
+  // (sigma-bar_zz = S_r p, laws/micropolar_drucker_prager.hpp), so the solve for p_{n+1} takes
+  // the change known at its start, a step late, as the explicit undrained split does; the
+  // bookkeeping (finish_projection) books the same lagged change, so each balance holds as the
+  // solve enforced it and water is conserved to the solve's tolerance. Over a run the water sees
+  // every plastic thickness change but the last step's.
+  Scalars lagged_plastic_source(double dt, const Scalars& shift) {
+    shift_ = shift;
+    if (shift.extent(0) == 0)
+      return source_;
+    const std::size_t n = disc_.points.n_owned;
+    if (lag_.extent(0) != n) {
+      lag_ = Scalars("mupm::lagged_plastic_thickness_change", n);
+      lagged_source_ = Scalars("mupm::lagged_plastic_source", n);
+    }
+    Kokkos::deep_copy(lag_, Kokkos::subview(shift, std::make_pair(std::size_t(0), n)));
+    auto out = lagged_source_, src = source_, lag = lag_, sr = sr_old_;
+    const double b = prm_.pore.biot / dt;
+    Kokkos::parallel_for(
+        "mupm::Fluid::lagged_plastic_source", range(0, n),
+        KOKKOS_LAMBDA(const std::size_t i) { out(i) = src(i) - b * sr(i) * lag(i); });
+    return lagged_source_;
   }
 
   void reset_strain_reference() {
@@ -873,6 +906,9 @@ class FluidSolver : public Module {
   LinearSolveSettings solve_settings_;
   std::unique_ptr<PressureProjection<Dim>> projection_;
   Scalars dp_, hdp_, c_old_, sr_old_, flow_old_;
+  // Plane stress with plastic pore water (lagged_plastic_source): the skeleton's plastic
+  // thickness change (its View), the change this step's solve took, the source it solved with.
+  Scalars shift_, lag_, lagged_source_;
   SolveStats stats_;
   double solve_scale_ = 0;
   bool semi_implicit_ = false;

@@ -101,10 +101,13 @@ class Mechanics : public Module {
 
 // The skeleton as the semi-implicit pressure step sees it (include/mupm/solvers/
 // pressure_projection.hpp): (u, theta) at the step's start [n_owned][Dim + R] (after move()),
-// the density rho and micro-inertia J [n_owned] of its lumped masses.
+// the density rho and micro-inertia J [n_owned] of its lumped masses, and plastic_shift
+// [n_owned]: the plastic thickness change of the last forces evaluated (plane stress with pore
+// water, include/mupm/laws/micropolar_drucker_prager.hpp: pore_shift at their state minus at the
+// step's start), a View the skeleton updates at each evaluation; empty where there is none.
 struct SkeletonState {
   Vectors start;
-  Scalars density, inertia;
+  Scalars density, inertia, plastic_shift;
 };
 
 // A mechanics whose step the semi-implicit pressure splits: move() advances the positions,

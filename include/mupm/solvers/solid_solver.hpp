@@ -162,6 +162,9 @@ class SolidSolver : public Mechanics, public Skeleton {
     couple_ = Vectors("mupm::body_couple", p.n_owned, R);
     du_ = Vectors("mupm::step_increment", energy_criterion() ? p.size() : p.n_owned, Dim + R);
     vs_old_ = Scalars("mupm::volumetric_strain_old", p.n_owned);
+    if constexpr (Law::plastic)
+      if (law_.pore_water && set_.semi_implicit)
+        shift_step_ = Scalars("mupm::plastic_thickness_change", p.n_owned);
     if (breaks()) {
       f_old_ = Vectors("mupm::force_before_breakage", p.n_owned, Dim);
       l_old_ = Vectors("mupm::moment_before_breakage", p.n_owned, R);
@@ -355,7 +358,7 @@ class SolidSolver : public Mechanics, public Skeleton {
     advance_positions(p, dt);
     apply_kinematic(bcs_, p, t, dt);
   }
-  SkeletonState skeleton_state() const override { return {du_, rho_, inertia_}; }
+  SkeletonState skeleton_state() const override { return {du_, rho_, inertia_, shift_step_}; }
   // The pressure correction's work on the skeleton, part of the pore work (W_pore).
   void add_projection_work(double w) override {
     pore_work_ += w;
@@ -824,6 +827,23 @@ class SolidSolver : public Mechanics, public Skeleton {
             tr += eps(i, d * Dim + d);
           vs(i) = tr;
         });
+    update_shift_step();
+  }
+  // The plastic thickness change of the forces just evaluated, pore_shift(current) -
+  // pore_shift(start) (SkeletonState::plastic_shift), from the law's state; again after a
+  // restore by keeping_plastic_state, so that it is always the kept state's.
+  void update_shift_step() {
+    if constexpr (Law::plastic) {
+      if (shift_step_.extent(0) == 0)
+        return;
+      const Law law = law_;
+      auto s = shift_step_;
+      Kokkos::parallel_for(
+          "mupm::Solid::plastic_thickness_change", range(0, disc_.points.n_owned),
+          KOKKOS_LAMBDA(const std::size_t i) {
+            s(i) = law.pore_shift(i) - law.pore_shift_start(i);
+          });
+    }
   }
 
   // The p* and the force and moment densities of the forces just applied, into the points'
@@ -939,6 +959,7 @@ class SolidSolver : public Mechanics, public Skeleton {
     f();
     for (std::size_t k = 0; k < kept.size(); ++k)
       Kokkos::deep_copy(plastic_current(disc_.points)[k], kept[k]);
+    update_shift_step();
   }
   // The fields the plastic law's return writes (its current state, the stress it commits, the
   // water's volumetric strain).
@@ -1070,6 +1091,7 @@ class SolidSolver : public Mechanics, public Skeleton {
   SolidState<Dim> st_;
   Scalars rho_, inertia_;
   Vectors body_, couple_, du_;
+  Scalars shift_step_;      // SkeletonState::plastic_shift (semi-implicit, plastic plane stress)
   Vectors crack_;           // the crack water's force density (Fracture Flow)
   Scalars pf_star_;         // p_f* of the crack force (owned points)
   Vectors face_load_;       // g of the crack force (owned and ghosts; kernels/fracture_flow.hpp)
