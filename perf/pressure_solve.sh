@@ -5,7 +5,7 @@
 # timers (max over ranks) and time_series.csv, on 1 rank and on 2 ranks (1 thread each).
 #   perf/pressure_solve.sh MUPM [CASE...]   CASE: example1 | cube50 | cube100 | crack | crack-kept
 #                                           | crack-whole (all by default)
-# example1: inputs/example1_deformation_driven.xml (Example 1 case 2, 100 x 100, delta = 3.015 dx)
+# example1: inputs/example1_deformation_driven_explicit.xml (Example 1 case 2, 100 x 100, delta = 3.015 dx)
 #   with incompressible water at the automatic (drained) step, 200 steps of the load's ramp.
 # cube50: a saturated 3D cube of 50^3 points, delta = 3.015 dx, incompressible, base fixed, top
 #   drained and pressed at 1 cm/s, 10 steps. cube100: the same at 100^3 = 1e6 points with
@@ -41,7 +41,7 @@ example1() {  # example1 FOLDER
   mapfile -t shared < <(shared_edits "$1")
   sed -E -e 's|<Parameter name="Time Step" type="double" value="[^"]*"/>|<Parameter name="Automatic Time Step" type="bool" value="true"/><Parameter name="Pressure Integration" type="string" value="Semi-Implicit"/>|' \
     -e 's|<Parameter name="Number of Steps" type="int" value="[0-9]+"/>|<Parameter name="Number of Steps" type="int" value="200"/>|' \
-    "${shared[@]}" "$SRC/inputs/example1_deformation_driven.xml"
+    "${shared[@]}" "$SRC/inputs/example1_deformation_driven_explicit.xml"
 }
 crack() {  # crack FOLDER DROP_TOLERANCE REFRESH_INTERVAL
   local shared

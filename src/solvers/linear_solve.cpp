@@ -232,8 +232,11 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
   // one's: a step whose right-hand side is round-off (a steady state) needs no digits of it.
   LinearSolveResult r;
   const double bn = b.norm2();
-  if (!std::isfinite(bn))
-    return r;  // not converged: the caller stops the run
+  if (!std::isfinite(bn)) {  // not converged: the caller stops the run
+    r.finite_rhs = false;
+    r.residual = bn;
+    return r;
+  }
   scale = std::max(scale, bn);
   if (!(bn > 0)) {
     x.putScalar(0.0);

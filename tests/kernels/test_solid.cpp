@@ -1,5 +1,6 @@
-// Micropolar correspondence kernels: patch tests, zero-energy mode, conservation, and the
-// closed forms of VALIDATION.md sections 2 and 3, and the P-wave speed.
+// Micropolar correspondence kernels: patch tests, zero-energy mode, and conservation of momenta
+// and energy in an undamped free body. The closed forms (the Cosserat layer in simple shear, the
+// P-wave speed) are in tests/solvers/test_solid_validation.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,7 +1,7 @@
 // The fluid step and the staggered coupling against conservation laws and closed forms:
 // fluid mass with impervious boundaries, sources and drained boundaries; decay of a
 // checkerboard pressure mode; an unsaturated column reaching uniform suction; Terzaghi's
-// consolidation (VALIDATION §4); the two staggering orders converging to each other.
+// consolidation (closed form below); the two staggering orders converging to each other.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -311,7 +311,7 @@ TEST(FluidSolver, UnsaturatedColumnReachesUniformSuction) {
     std::printf("[ column ] p_eq = %.2f Pa, reached %.2f .. %.2f Pa\n", p_eq, pmin, pmax);
 }
 
-// Terzaghi's consolidation (VALIDATION §4) on a 2D column: load q ramped on the top row,
+// Terzaghi's one-dimensional consolidation on a 2D column: load q ramped on the top row,
 // drained (p = 0) top and bottom layers, u fixed at the bottom, lateral walls u_x = 0. By
 // symmetry the doubly drained column of height 2H is the classical layer of thickness H with
 // an impervious base at mid-height. With compressible water the closed form keeps its shape
@@ -462,8 +462,8 @@ double max_pressure_difference(const ColumnRun& a, const ColumnRun& b) {
 // as if about 2.3 dx farther away, an error of first order in delta/H (measured: the error
 // of U at T_v = 0.5 is 0.106, 0.054, 0.029 at H = 10, 20, 40 dx). The test therefore runs
 // H = 10 dx and 20 dx, checks that the error halves, and holds the Richardson extrapolation
-// 2 f(20) - f(10) of the degree of consolidation U and of p at the impervious plane to
-// VALIDATION's 3 % of p0.
+// 2 f(20) - f(10) of the degree of consolidation U and of p at the impervious plane to 3 % of
+// p0, the target tolerance of this case away from the first few dx at the drained face.
 namespace {
 struct TerzaghiResult {
   double U[3], U_cf[3], base[3], base_cf[3], worst[3];

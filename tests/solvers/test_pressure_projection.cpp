@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "mupm/input/model.hpp"
 #include "mupm/solvers/fluid_solver.hpp"
@@ -461,6 +462,37 @@ TEST(PressureProjectionSolve, IluBreakdownFallsBackToJacobi) {
   auto xv = x.getLocalViewHost(Tpetra::Access::ReadOnly);
   for (std::size_t l = 0; l < map->getNodeNumElements(); ++l)
     EXPECT_NEAR(xv(l, 0), exact[map->getGlobalElement(LocalId(l)) % 3], 1e-10);
+}
+
+// A right-hand side with a NaN (a run gone unstable before its solve) is reported as such, on
+// every rank (the norm is global), not as a solve that stopped at a relative residual of 0
+// after 0 iterations; a finite one on the same matrix solves.
+TEST(PressureProjectionSolve, NonFiniteRightHandSideIsReported) {
+  const GlobalId n = 4;
+  auto map = Teuchos::rcp(new Map(Tpetra::global_size_t(n), 0, test::world()));
+  auto a = Teuchos::rcp(new CrsMatrix(map, 1));
+  for (std::size_t l = 0; l < map->getNodeNumElements(); ++l) {
+    const GlobalId row = map->getGlobalElement(LocalId(l));
+    const GlobalId col[1] = {row};
+    const double val[1] = {2.0};
+    a->insertGlobalValues(row, Teuchos::ArrayView<const GlobalId>(col, 1),
+                          Teuchos::ArrayView<const double>(val, 1));
+  }
+  a->fillComplete();
+  LinearSolve solve(LinearSolveSettings{});
+  solve.set_matrix(a);
+  TpetraVector b(map), x(map);
+  b.putScalar(1.0);
+  double scale = 0;
+  EXPECT_TRUE(solve.solve(b, x, scale).finite_rhs);
+  if (map->getGlobalElement(0) == 0) {  // the rank holding row 0
+    auto bv = b.getLocalViewHost(Tpetra::Access::ReadWrite);
+    bv(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  }
+  const LinearSolveResult r = solve.solve(b, x, scale);
+  EXPECT_FALSE(r.finite_rhs);
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.iterations, 0);
 }
 
 }  // namespace

@@ -1,7 +1,6 @@
 // Central-difference (velocity Verlet) integration of u and theta (paper eqs 127-136 with
-// beta1 = 1/2, beta2 = 0; FORMULATION "Time integration"), with optional mass-proportional
-// damping for dynamic relaxation. Prescribed components (Points::fixed) are left to the
-// boundary conditions.
+// beta1 = 1/2, beta2 = 0), with optional mass-proportional damping for dynamic relaxation.
+// Prescribed components (Points::fixed) are left to the boundary conditions.
 #ifndef MUPM_CENTRAL_DIFFERENCE_HPP
 #define MUPM_CENTRAL_DIFFERENCE_HPP
 

@@ -1,4 +1,4 @@
-// Damage of a point from its bonds (paper eq 37; FORMULATION "Fracture"):
+// Damage of a point from its bonds (paper eq 37):
 // D_i = 1 - sum_j rho_ij omega V_j / sum_j omega V_j over the family, rho_ij = 1 for an intact
 // bond and 0 for a broken one, omega = 1; and the fracture points (eq 104): D_i >= D_cr, or next
 // to a pre-crack. Kernels only.
@@ -59,7 +59,7 @@ void compute_damage(const Bonds& bonds, const Points<Dim>& p, double critical_da
       });
 }
 
-// Crack aperture of the points with broken bonds (eqs 38-39; FORMULATION "Fracture").
+// Crack aperture of the points with broken bonds (eqs 38-39).
 // Eq 38, c = y~ cos(beta) - x, is the opening of a broken bond across the crack: with beta the
 // angle between the deformed bond y = xi + U and the crack normal n, and x the reference bond's
 // normal component xi.n (the paper's Figure 3), c = (xi + U).n - xi.n = U.n, U = u_j - u_i. The

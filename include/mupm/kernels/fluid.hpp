@@ -1,7 +1,7 @@
 // Unsaturated pore-fluid flow in the bulk: nonlocal pressure gradient, Darcy flux, stabilized
 // flow states and the mass balance (paper eqs 12, 14, 52, 54, 56, 59, 72, 74, 76, 78, 113-117,
-// 121-122, 141-146; FORMULATION "Pass 1", "Fluid: mass balance"). Kernels only: no MPI (the
-// solver refreshes the ghosts between the passes, include/mupm/solvers/fluid_solver.hpp).
+// 121-122, 141-146). Kernels only: no MPI (the solver refreshes the ghosts between the passes,
+// include/mupm/solvers/fluid_solver.hpp).
 //
 // Pass 1 (per point i, intact bonds):
 //   K_i = sum_j omega xi (x) xi V_j,   grad p_i = K_i^-1 sum_j omega (p_j - p_i) xi V_j   (eq 59)
@@ -38,7 +38,8 @@
 // truncated families, get a proportionally larger alpha. (For comparison, the 2D analogue of
 // the paper's 1/|xi| form is C_3 = 6k / (pi h delta^3).)
 //
-// Mass balance (eqs 14, 113-117, 143 with FORMULATION's storage):
+// Mass balance (eqs 14, 113-117, 143; the paper's storage phi dS_r/dp alone is zero where the
+// point is saturated, so C adds the water's compressibility phi S_r / K_w, keeping C > 0):
 //   C_i dp_i/dt = -S_r,i dV_s,i/dt - div_i + s_i,   C = phi dS_r/dp + phi S_r / K_w,
 // with dV_s/dt the rate of the volumetric strain tr(eps) of the solid (eq 117) and s_i a source
 // [1/s]. Forward Euler (eqs 141, 145 with beta_3 = 0). In plane stress (PoreCoupling,

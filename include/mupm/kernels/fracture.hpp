@@ -1,5 +1,4 @@
-// Energy-based bond breakage (paper eqs 34-37, Algorithm 4; FORMULATION "Fracture"). Kernels
-// only.
+// Energy-based bond breakage (paper eqs 34-37, Algorithm 4). Kernels only.
 //
 // The bond energy W (eq 34) is accumulated per pair of unit volumes by solid pass 2
 // (include/mupm/kernels/solid.hpp); a bond breaks (rho = 0, eq 35) once W >= W_cr.

@@ -1,7 +1,7 @@
 // Fracture flow: the crack's normal, its cubic-law conductances and storage, and the force of
-// the crack's water on its faces (paper eqs 17-19, 38-39, 58, 114, 118-120, 144, 146;
-// FORMULATION "Fracture"). Kernels and plain functions only: no MPI. The network solve that
-// uses them is include/mupm/solvers/fracture_flow.hpp.
+// the crack's water on its faces (paper eqs 17-19, 38-39, 58, 114, 118-120, 144, 146). Kernels
+// and plain functions only: no MPI. The network solve that uses them is
+// include/mupm/solvers/fracture_flow.hpp.
 //
 // The fracture space of a point. A crack of opening a between two faces is seen by the fracture
 // points (D >= D_cr) around it: for a straight crack along a lattice plane with delta = 3 dx and
@@ -17,8 +17,8 @@
 // with the correspondence gradient of the fracture family and k_f = a^2/12. The fracture family
 // of a crack one or two rows thick is nearly a line (a plane in 3D): its shape tensor is
 // singular across the crack, and k_f = a^2/12 smeared over a point of width dx passes dx/a times
-// the cubic law (FORMULATION). We use bond-based flow over the fracture bonds (both ends
-// fracture points, eq 104, broken or not), volume rate from j to i
+// the cubic law. We use bond-based flow over the fracture bonds (both ends fracture points,
+// eq 104, broken or not), volume rate from j to i
 //   F_ij = Lambda_ij (p_f,j - p_f,i),   Lambda_ij = (kappa_i + kappa_j) / 2,
 // with kappa_i calibrated to the cubic law: a crack of aperture a passes a^3/(12 mu_w) dp/ds per
 // unit width. Under a uniform gradient g along the crack (tangent t), the rate across a

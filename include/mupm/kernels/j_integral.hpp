@@ -3,8 +3,10 @@
 // sums them over the ranks in a fixed order (include/mupm/solvers/j_integral.hpp).
 //
 // Derivation (the paper's eq 30 carries its cross term with one xi for two bonds; this is the
-// reading that follows from the model's own energy, FORMULATION "Pass 2"). A point's energy rate
-// is dW_i/dt = sum_j [T_ij.(du_j - du_i - (dth_i + dth_j)/2 x xi_ij) + M_ij.(dth_j - dth_i)] V_j.
+// reading that follows from the model's own energy: the discrete energy Psi whose derivatives are
+// the force and moment states of pass 2, eqs 105-112, include/mupm/kernels/solid.hpp). A point's
+// energy rate is
+//   dW_i/dt = sum_j [T_ij.(du_j - du_i - (dth_i + dth_j)/2 x xi_ij) + M_ij.(dth_j - dth_i)] V_j.
 // Summed over a region B1, the pairs inside cancel against B1's share of the force and moment
 // balances (f_i = 0, l_i = 0 in equilibrium), and what is left is the power that crosses the
 // contour through the bonds i in B1, j outside (B2):
@@ -15,11 +17,12 @@
 //   J = int_{dB1} W n.d dA - sum_{i in B1, j in B2} V_i V_j [ T_ij.u_1(j) - T_ji.u_1(i)
 //       + M_ij th_1(j) - M_ji th_1(i) - 1/2 ((xi x T_ij) th_1(j) + (xi x T_ji) th_1(i)) ],
 // with u_1 = (grad u) d, th_1 = kappa d the derivatives along d from the nonlocal gradients:
-// grad u = eps + the rotation eps subtracts (2D: eps_xy = du_x/dy + theta, eps_yx = du_y/dx -
-// theta, FORMULATION "Pass 1", so du_x/dy = eps_xy - theta, du_y/dx = eps_yx + theta). For an
-// affine field the bond sum is t.u_1 integrated over the contour (t = sigma n: sum_{B1,B2} (T_ij -
-// T_ji) V_i V_j is the force B2 exerts on B1), so this is the continuum micropolar J, int (W n_1 -
-// t.u_1 - m th_1) dA. J per unit thickness (the paper's Pa m, G = J/h of eq 126) divides by h.
+// grad u = eps + the rotation eps subtracts (eq 50 with U^ = U - Omega-bar x xi; 2D, theta
+// counterclockwise: eps_xy = du_x/dy + theta, eps_yx = du_y/dx - theta, so du_x/dy = eps_xy -
+// theta, du_y/dx = eps_yx + theta). For an affine field the bond sum is t.u_1 integrated over
+// the contour (t = sigma n: sum_{B1,B2} (T_ij - T_ji) V_i V_j is the force B2 exerts on B1), so
+// this is the continuum micropolar J, int (W n_1 - t.u_1 - m th_1) dA. J per unit thickness (the
+// paper's Pa m, G = J/h of eq 126) divides by h.
 //
 // The parts (the paper's Tables 1 and 3): translational = the W term and the u terms; micro-
 // rotational = the theta terms (the M terms and the 1/2 xi x T terms). The paper's tables add up

@@ -1,4 +1,4 @@
-// The nonlocal shape tensor of pass 1 (paper eq 45; FORMULATION "Pass 1"):
+// The nonlocal shape tensor of pass 1 (paper eq 45):
 // K_i = sum_j omega_ij (xi (x) xi) V_j over the intact bonds, xi = x_j - x_i, omega = 1 (unit
 // influence) for an intact bond and 0 for a broken one.
 #ifndef MUPM_SHAPE_TENSOR_HPP

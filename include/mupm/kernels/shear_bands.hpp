@@ -1,5 +1,5 @@
-// Shear-band diagnostics: the nonlocal second-order work (paper eq 42; FORMULATION
-// "Second-order work") and the band measurement of the CSV (band_angle, band_width).
+// Shear-band diagnostics: the nonlocal second-order work (paper eq 42) and the band measurement
+// of the CSV (band_angle, band_width).
 //
 // Second-order work over a window of steps, per point (N/m^2 = J/m^3):
 //   d2E_i = sum_j (dT_ij . dU^_ij + dM_ij . dOmega_ij) V_j                     (eq 42)

@@ -1,5 +1,4 @@
-// Stabilized micropolar correspondence kernels (paper eqs 2-9, 43-51, 62-71, 96-112;
-// FORMULATION "Pass 1", "Pass 2", "Stabilization constants").
+// Stabilized micropolar correspondence kernels (paper eqs 2-9, 43-51, 62-71, 96-112).
 //
 // The discrete energy is
 //   Psi = sum_i V_i [ W(eps_i, kappa_i) + 1/2 sum_j (alpha1_ij |R1_ij|^2 + alpha2_ij |R2_ij|^2) V_j
@@ -304,8 +303,8 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
 // l_i = sum_j (M_ij - M_ji) V_j + 1/2 sum_j xi x (T_ij - T_ji) V_j. Needs the ghosts' u, theta,
 // eps, kappa, P1, P2, w0 (and increment, P1w when st.work is on).
 //
-// Bond energy (eq 34, FORMULATION "Fracture"), with st.work = Accumulate: per pair of unit
-// volumes, dW = (T_ij - T_ji).dU^ + (M_ij - M_ji).dOmega, integrated over the step by the
+// Bond energy (eq 34), with st.work = Accumulate: per pair of unit volumes,
+// dW = (T_ij - T_ji).dU^ + (M_ij - M_ji).dOmega, integrated over the step by the
 // trapezoid rule between the pair states of the last evaluation (Bonds::pair_force) and this
 // one. Summed over the pairs (times V_i V_j) this is exactly the work of the forces f, l on the
 // step's increments, the trapezoid the solid solver books as external work: elastic energy is

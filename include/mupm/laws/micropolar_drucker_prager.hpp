@@ -1,8 +1,10 @@
-// Micropolar Drucker-Prager plasticity with linear softening (paper eqs 82-95; FORMULATION
-// "Micropolar Drucker-Prager"): the return mapping at one point, and the law of pass 1
-// (include/mupm/kernels/solid.hpp) that applies it with the points' plastic state.
+// Micropolar Drucker-Prager plasticity with linear softening (paper eqs 82-95): the return
+// mapping at one point, and the law of pass 1 (include/mupm/kernels/solid.hpp) that applies it
+// with the points' plastic state.
 //
-// The model, as the paper writes it (eqs 84-91, literal form, see FORMULATION):
+// The model, as the paper writes it (eqs 84-91, taken literally: f's slope and intercept differ
+// from the usual outer-cone matching by factors 3 and sqrt3; the paper's example 3 yields at
+// about 2.6 % axial strain this way, and not at all within its 5 % stroke with the outer cone):
 //   sigma-tilde = -tr(sigma) 1 + 3/2 (sigma + sigma^T)                       (eq 86)
 //   q^2 = 1/2 (sigma : sigma-tilde + 3 m : m / l^2)                          (eq 84)
 //       = 3/2 (|s|^2 + |m|^2 / l^2),  s = dev sym(sigma)

@@ -1,5 +1,5 @@
-// Micropolar (Cosserat) linear elasticity (paper eqs 80-81; FORMULATION "Micropolar
-// Drucker-Prager", elastic law), mixture density (eq 1) and micro-inertia (eq 13).
+// Micropolar (Cosserat) linear elasticity (paper eqs 80-81), mixture density (eq 1) and
+// micro-inertia (eq 13).
 #ifndef MUPM_MICROPOLAR_ELASTIC_HPP
 #define MUPM_MICROPOLAR_ELASTIC_HPP
 

@@ -1,5 +1,5 @@
-// Stabilization constants (paper eqs 66-71 for the solid, 76-78 for the flow; FORMULATION
-// "Stabilization constants"): functions of the law's moduli and the family geometry only.
+// Stabilization constants (paper eqs 66-71 for the solid, 76-78 for the flow): functions of the
+// law's moduli and the family geometry only.
 #ifndef MUPM_STABILIZATION_HPP
 #define MUPM_STABILIZATION_HPP
 

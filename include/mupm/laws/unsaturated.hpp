@@ -1,5 +1,5 @@
 // Unsaturated pore water: van Genuchten retention (paper eq 12) and Mualem relative
-// permeability (eq 56), as a small value type usable inside kernels. FORMULATION "Fluid".
+// permeability (eq 56), as a small value type usable inside kernels.
 //
 // Pore pressure p is positive in compression, negative (suction s = -p) when unsaturated;
 // passive pore air (p_a = 0):

@@ -1,4 +1,4 @@
-// The fracture-flow step (paper eqs 18-19, 114, 118-120, 144, 146; FORMULATION "Fracture"):
+// The fracture-flow step (paper eqs 18-19, 114, 118-120, 144, 146):
 // the fracture pressure p_f on the fracture network, its water content, the exchange with the
 // bulk and the fracture conditions (Fracture Pressure, Fracture Source). Conductances, storage
 // and exchange are derived in include/mupm/kernels/fracture_flow.hpp.

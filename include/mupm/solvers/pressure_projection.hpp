@@ -209,7 +209,8 @@ class PressureProjection {
     int iterations = 0;
     double residual = 0;
     bool converged = false;
-    double work = 0;  // the correction's work on the skeleton [J], all ranks
+    bool finite_rhs = true;  // LinearSolveResult::finite_rhs
+    double work = 0;         // the correction's work on the skeleton [J], all ranks
   };
 
   // Step 2-3 of the header: dp [n_owned] and, with a fracture network, dpf [its owned points,
@@ -304,6 +305,7 @@ class PressureProjection {
     r.iterations = res.iterations;
     r.residual = res.residual;
     r.converged = res.converged;
+    r.finite_rhs = res.finite_rhs;
     images_matrix_->apply(x, y);  // the increments: S_H x + c
     y.update(1.0, c, 1.0);
     TpetraVector yp(joint_), f(dofs_);  // the skeleton's correction: S_P x + c

@@ -1,6 +1,7 @@
 // The step of Algorithm 1, written once: the mechanics (the micropolar solid, or kinematics
 // alone) advances u and theta, then bond breakage and damage, then the fluid; with Staggering =
-// Fluid First the fluid comes before the mechanics instead (FORMULATION "Time integration").
+// Fluid First the fluid comes before the mechanics instead (the paper's "dual-direction"
+// staggering, Algorithm 1 and eqs 127-149, e.g. fluid first for fluid-driven cracks).
 // The fluid advances once every `fluid_every` steps over their combined interval, in `substeps`
 // equal steps:
 //   Solid First: the solid steps with p held; after the last solid step of an interval the
