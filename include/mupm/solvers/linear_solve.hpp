@@ -52,7 +52,7 @@ struct LinearSolveSettings {
 struct LinearSolveResult {
   bool converged = false;
   int iterations = 0;
-  double residual = 0;  // the achieved ||b - A x|| / the largest ||b|| (Belos' estimate)
+  double residual = 0;     // the achieved ||b - A x|| / the largest ||b|| (Belos' estimate)
   bool finite_rhs = true;  // false: b held an inf or NaN, no solve was tried
 };
 
