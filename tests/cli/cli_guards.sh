@@ -135,7 +135,7 @@ expect water_film 2 'was written with mupm->Fracture->Minimum Aperture = 0.0001,
 # since each balance's stored energy stayed below its own pore work. The coupled system's check
 # stops it (exit 3) and says why.
 sed -e 's|value="Face Pressure"|value="Eq 17"|' -e 's|name="End Time" type="double" value="0.5"|name="End Time" type="double" value="1.3e-4"|' \
-  -e 's|value="output/example1_fluid_driven_66"|value="eq17"|' "$SRC/inputs/example1_fluid_driven_66.xml" >eq17.xml
+  -e 's|value="output/example1_fluid_driven_66_explicit"|value="eq17"|' "$SRC/inputs/example1_fluid_driven_66_explicit.xml" >eq17.xml
 grep -q 'value="Eq 17"' eq17.xml && grep -q 'value="1.3e-4"' eq17.xml || fail "eq17.xml not derived"
 expect eq17 3 'Error, the coupled system diverged at step' 'times the energy supplied from outside' 'Crack Water Force = Eq 17'
 # Output->Folder holds one run at a time: a second run into the folder of a running one is

@@ -81,14 +81,14 @@ ff_input() {  # FOLDER STEPS RESTART [CHECKPOINT_INTERVAL]
     -e "s|<Parameter name=\"Checkpoint Interval\" type=\"int\" value=\"0\"/>|<Parameter name=\"Checkpoint Interval\" type=\"int\" value=\"${4:-0}\"/>|" \
     -e "s|<Parameter name=\"Time Series Interval\" type=\"int\" value=\"[0-9]+\"/>|<Parameter name=\"Time Series Interval\" type=\"int\" value=\"1\"/>|" \
     -e "s|<Parameter name=\"Minimum Aperture\" type=\"double\" value=\"1e-4\"/>|<Parameter name=\"Minimum Aperture\" type=\"double\" value=\"1e-6\"/>|" \
-    "$SRC/inputs/example1_fluid_driven_66.xml"
+    "$SRC/inputs/example1_fluid_driven_66_explicit.xml"
 }
 ff_input ff_straight 40 "" 20 >ff_straight.xml
 ff_input ff_first 20 "" >ff_first.xml
 ff_input ff_second 40 ff_first/checkpoint.h5 >ff_second.xml
 ff_input ff_threads 40 "" >ff_threads.xml
 for k in 'value="Semi-Implicit"' '"Incompressible"' '"Restart From"' 'Checkpoint Interval" type="int" value="20"' 'Refresh Interval" type="int" value="7"' 'Minimum Aperture" type="double" value="1e-6"'; do
-  grep -q "$k" ff_straight.xml || fail "inputs/example1_fluid_driven_66.xml changed: ff_straight.xml lacks $k"
+  grep -q "$k" ff_straight.xml || fail "inputs/example1_fluid_driven_66_explicit.xml changed: ff_straight.xml lacks $k"
 done
 for c in ff_straight ff_first ff_second; do
   run 2 1 $c.xml >$c.out 2>&1 || { cat $c.out; fail "$c.xml did not run"; }

@@ -782,7 +782,8 @@ TEST(FractureFlowSemiImplicit, IncompressibleCrackOpensByTheInjectedVolume) {
 // The crack water's balance is booked with the opening over the bonds the solve used, and the
 // broken bonds' jump of the mean opening enters the next step's water balance: the balance
 // closes to round-off through the breakage (measured with the opening taken after the
-// breakage instead: off by 58 % of its scale here), and water is conserved.
+// breakage instead: off by 58 % of its scale here), and water is conserved. The solid's balance
+// closes through the first breakage step.
 TEST(FractureFlowSemiImplicit, CrackWaterBalanceHoldsThroughBreakage) {
   constexpr double dx = 5e-3;
   auto g = test::box<2>({32, 16}, 2.0, dx);
@@ -817,16 +818,21 @@ TEST(FractureFlowSemiImplicit, CrackWaterBalanceHoldsThroughBreakage) {
   auto& solid = run.solid;
   auto& seq = run.seq;
   const double dt = 0.5 * solid.estimate_stable_dt();
+  solid.set_time_step(dt);  // the ledger's kinetic shift (SolidSolver::Energy)
   const long long broken0 = solid.broken_pairs();
   const double water0 = fluid.fluid_mass();
   const auto* ff = fluid.fracture_flow();
-  double worst = 0;
+  double worst = 0, solid_worst = 0, solid_first = -1;
+  const double solid0 = solid.energy().balance();
   int n = 0, after = 0;
   for (; n < 1500 && after < 100; ++n) {
     seq.step(n, n * dt, dt);
     worst = std::max(worst, std::abs(ff->energy().balance()) / ff->energy().scale());
-    if (solid.broken_pairs() > broken0)
-      ++after;
+    const auto e = solid.energy();
+    const double solid_error = std::abs(e.balance() - solid0) / e.scale();
+    solid_worst = std::max(solid_worst, solid_error);
+    if (solid.broken_pairs() > broken0 && after++ == 0)
+      solid_first = solid_error;  // the step of the first breakage
   }
   const double water = fluid.fluid_mass() + ff->mass();
   int rank = 0;
@@ -834,11 +840,20 @@ TEST(FractureFlowSemiImplicit, CrackWaterBalanceHoldsThroughBreakage) {
   if (rank == 0)
     std::printf(
         "semi-implicit crack through breakage: %lld pairs broken in %d steps of %.3e s; crack "
-        "water balance at most %.2e of its scale; water error %.2e kg of %.3e kg\n",
-        solid.broken_pairs() - broken0, n, dt, worst, water - water0 - ff->inflows()[0], water0);
+        "water balance at most %.2e of its scale; water error %.2e kg of %.3e kg; solid balance "
+        "%.2e of its scale after the first breakage step, at most %.2e\n",
+        solid.broken_pairs() - broken0, n, dt, worst, water - water0 - ff->inflows()[0], water0,
+        solid_first, solid_worst);
   EXPECT_GT(solid.broken_pairs(), broken0);  // the tip broke
   EXPECT_LT(worst, 1e-10);
   EXPECT_LT(std::abs(water - water0 - ff->inflows()[0]), 1e-12 * water0);
+  // The solid's balance through the first breakage step: the jump of the kinetic shift with the
+  // accelerations is booked with the fracture dissipation (SolidSolver::after_breakage): closed
+  // to round-off (unbooked, 1.4e-3 of the scale). Later steps here drift by up to 0.34 of the
+  // scale as the crack runs through the plate (282 pairs in 106 steps, points joining the
+  // network): not closed, recorded in inputs/README.md (Example 1 case 1, semi-implicit).
+  EXPECT_GE(solid_first, 0.0);
+  EXPECT_LT(solid_first, 1e-12);
 }
 
 }  // namespace
