@@ -352,14 +352,15 @@ class FluidSolver : public Module {
     const auto r =
         projection_->step(dt, prm_, st_, source, target, skel, dp_, solve_scale_, crack, dpf);
     stats_ = {double(r.iterations), r.residual, double(projection_->assemblies())};
-    if (!r.finite_rhs)
-      throw CollectiveError(
-          "the pressure solve's right-hand side is not finite at t = " + std::to_string(t + dt) +
-          " s (the skeleton's predicted motion or the sources hold an inf or NaN): the run has "
-          "become unstable; a smaller mupm->Solver->Time Step (or Time Step Safety Factor) may "
-          "hold it");
     if (!r.converged) {
       std::ostringstream m;
+      if (!r.finite_rhs) {
+        m << "the pressure solve's right-hand side is not finite at t = " << t + dt
+          << " s (the skeleton's predicted motion or the sources hold an inf or NaN): the run "
+             "has become unstable; a smaller mupm->Solver->Time Step (or Time Step Safety "
+             "Factor) may hold it";
+        throw CollectiveError(m.str());
+      }
       m << "the pressure solve did not converge at t = " << t + dt << " s: relative residual "
         << r.residual << " after " << r.iterations
         << " iterations (mupm->Solver->Pressure Solve: Tolerance, Maximum Iterations, "
