@@ -528,12 +528,12 @@ RCP<ParameterList> valid_parameters() {
              "case 1). 0: the whole matrix.",
              rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1.0)));
       ps.set("Preconditioner Refresh Interval", 20,
-             "With a fracture network the matrix's values change every step (the cubic law's "
-             "apertures): the preconditioner is computed again on every this-many-th change and "
-             "at the step after a checkpoint (so that a restart continues bit for bit), and kept "
-             "in between; the solve still reaches Tolerance on the current matrix, only its "
-             "iterations depend on it. 1: every step. A new matrix graph (bonds broken, points "
-             "joining the network) always computes it.",
+             "When the matrix's values change (every step with a fracture network or "
+             "unsaturated water, at each step that breaks bonds) the preconditioner is computed "
+             "again on every this-many-th change and at the step after a checkpoint (so that a "
+             "restart continues bit for bit), and kept in between; the solve still reaches "
+             "Tolerance on the current matrix, only its iterations depend on it. 1: every "
+             "change. A new matrix graph (points joining the network) always computes it.",
              at_least(1));
       ps.set("Tolerance", 1e-11,
              "Residual ||b - A x|| at which the solve stops, relative to the largest right-hand "

@@ -74,6 +74,7 @@ class LinearSolve {
   // The next refresh computes the numeric part (and counts from there): called where a
   // checkpoint was written, so that the run goes on with the factors a restart from it builds.
   void renew() { renew_ = true; }
+  bool renewal_pending() const { return renew_; }
   // Solves A x = b (x: the initial guess on entry) to the tolerance times `scale`, the largest
   // ||b|| so far (updated here; a caller that restarts keeps it). Collective.
   LinearSolveResult solve(const TpetraVector& b, TpetraVector& x, double& scale);

@@ -144,7 +144,8 @@
 // Lambda): with a network their values are added to the kept rest in place on a kept graph, and
 // the preconditioner's factors are computed again every Preconditioner Refresh Interval steps
 // and after each checkpoint, kept in between (compose, LinearSolve::refresh); the joint map
-// changes when points join, or B_f when bonds break: then everything is assembled again. Measured
+// changes when points join, or B_f's columns when bonds break: then the graphs are built again.
+// Measured
 // (tests/solvers/test_fracture_flow.cpp, FractureFlowSemiImplicit): incompressible water injected
 // into a free slot opens it by the injected volume to 1e-10 at the drained step; against the
 // explicit scheme on Example 1 case 1 at 66 x 66 (K_w = 2.2 GPa, a_min = 0.1 mm, the first 20 us):
@@ -153,11 +154,16 @@
 // one 1.706e-6, 2.094e-6 and 2.236e-6 J at 0.05, 0.01 and 0.002 us, first order in dt towards it
 // (the explicit crack force lags by a step, fracture_flow.hpp).
 //
-// The matrix and its preconditioner are kept while the bonds, the time step, the saturation,
-// the relative permeability and the densities are unchanged (a saturated run without breakage
-// assembles once). The solve is CG where A is symmetric (no image points; krylov below),
-// GMRES otherwise, each with ILU(k) of A less its small (far) entries: Pressure Solve's Drop
-// Tolerance (include/mupm/solvers/linear_solve.hpp).
+// The matrix is kept while the bonds, the time step, the saturation, the relative permeability
+// and the densities are unchanged (a saturated run without breakage assembles once). When they
+// change its values are written again on kept graphs (include/mupm/solvers/kept_matrix.hpp):
+// the graphs hold every bond of the lists (a broken one at zero) and change only with the
+// network's points or B_f's columns; B~ = diag(S_r) B_0 and the transposes of B_0 and of the
+// flow's gradient are kept while the bonds are, so a change of S_r, k_r or the densities needs
+// no transpose. The preconditioner's factors then follow LinearSolve::refresh (kept up to
+// Preconditioner Refresh Interval steps, renewed after each checkpoint). The solve is CG where A
+// is symmetric (no image points; krylov below), GMRES otherwise, each with ILU(k) of A less its
+// small (far) entries: Pressure Solve's Drop Tolerance (include/mupm/solvers/linear_solve.hpp).
 #ifndef MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 #define MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 
@@ -187,7 +193,8 @@ class PressureProjection {
   PressureProjection(Discretization<Dim>& disc, const LinearSolveSettings& settings,
                      std::vector<PressureRole> roles, std::vector<LocalId> images, MPI_Comm comm)
       : disc_(disc),
-        solver_(krylov(settings, roles, comm)),
+        images_any_(any_images(roles, comm)),
+        solver_(krylov(settings, images_any_)),
         roles_(std::move(roles)),
         images_(std::move(images)),
         comm_(comm) {
@@ -225,18 +232,23 @@ class PressureProjection {
     ScopedRegion region("mupm::Pressure::projection");
     auto& p = disc_.points;
     const std::size_t n = p.n_owned, m = crack.point.size();
-    if (needs_assembly(dt, st, sk, crack))
+    const bool refilled = needs_assembly(dt, st, sk, crack);
+    if (refilled)
       assemble(dt, prm, st, sk, crack);
     Teuchos::RCP<CrsMatrix> network;
     if (any_crack_) {  // the network's rows change every step (apertures): new values
       network = network_rows(crack);
       auto ns = Teuchos::rcp(new CrsMatrix(joint_, 0));
-      Tpetra::MatrixMatrix::Multiply(*network, false, *images_matrix_, false, *ns);
+      Tpetra::MatrixMatrix::Multiply(*network, false, *s_h_.matrix(), false, *ns);
       ns->leftScale(*keep_);
       compose(*ns);
-    } else if (system_ != composed_) {
-      system_ = composed_;
+    } else if (system_ != composed_.matrix()) {
+      system_ = composed_.matrix();
       solver_.set_matrix(system_);
+    } else if (refilled || solver_.renewal_pending()) {
+      // New values on the kept graph (or a checkpoint's renewal of the factors: a restart
+      // computes them from these values).
+      solver_.refresh();
     }
     const auto& owned = disc_.dist.owned_map();
     TpetraVector du(dofs_), bp(owned), b(joint_), c(joint_), ac(joint_), x(joint_), y(joint_);
@@ -249,7 +261,8 @@ class PressureProjection {
           v(i * NC + Dim + r, 0) = p.theta(i, r) - sk.start(i, Dim + r);
       }
     }
-    coupling_->apply(du, bp);
+    coupling_.matrix()->apply(du, bp);  // B_0 du, then diag(S_r)
+    bp.elementWiseMultiply(1.0, *saturation_, bp, 0.0);
     {
       auto cv = c.getLocalViewHost(Tpetra::Access::OverwriteAll);
       for (std::size_t i = 0; i < n; ++i)
@@ -257,8 +270,8 @@ class PressureProjection {
       for (std::size_t k = 0; k < m; ++k)
         cv(n + k, 0) = crack.held[k] ? crack.start[k] : 0.0;
     }
-    static_->apply(c, ac);   // A c = (static part + the network's rows) c
-    TpetraVector e(joint_);  // the unfelt p_f^n (CrackBlock): the correction applies it too
+    static_.matrix()->apply(c, ac);  // A c = (static part + the network's rows) c
+    TpetraVector e(joint_);          // the unfelt p_f^n (CrackBlock): the correction applies it too
     if (any_crack_) {
       network->apply(c, ac, Teuchos::NO_TRANS, 1.0, 1.0);
       {
@@ -270,9 +283,9 @@ class PressureProjection {
       }
       // ... and the volume change it gives the skeleton within the step: dt^2 B M^-1 B^T e.
       TpetraVector fe(dofs_), be(joint_);
-      joint_coupling_->apply(e, fe, Teuchos::TRANS);
+      coupling_s_->apply(e, fe, Teuchos::TRANS);
       fe.elementWiseMultiply(1.0, *inverse_mass_, fe, 0.0);
-      joint_coupling_->apply(fe, be);
+      coupling_s_->apply(fe, be);
       ac.update(dt * dt, be, 1.0);
     } else {
       e.putScalar(0.0);
@@ -306,12 +319,12 @@ class PressureProjection {
     r.residual = res.residual;
     r.converged = res.converged;
     r.finite_rhs = res.finite_rhs;
-    images_matrix_->apply(x, y);  // the increments: S_H x + c
+    s_h_.matrix()->apply(x, y);  // the increments: S_H x + c
     y.update(1.0, c, 1.0);
     TpetraVector yp(joint_), f(dofs_);  // the skeleton's correction: S_P x + c
-    free_matrix_->apply(x, yp);
+    s_p_.matrix()->apply(x, yp);
     yp.update(1.0, c, 1.0, e, 1.0);
-    joint_coupling_->apply(yp, f, Teuchos::TRANS);
+    coupling_s_->apply(yp, f, Teuchos::TRANS);
     double work = 0;
     {
       auto yv = y.getLocalViewHost(Tpetra::Access::ReadOnly);
@@ -353,52 +366,69 @@ class PressureProjection {
       for (std::size_t i = 0; i < disc_.points.n_owned; ++i)
         v(i, 0) = dp(i);
     }
-    flow_->apply(x, y);
+    flow_.matrix()->apply(x, y);
     auto v = y.getLocalViewHost(Tpetra::Access::ReadOnly);
     for (std::size_t i = 0; i < disc_.points.n_owned; ++i)
       out(i) = v(i, 0);
   }
 
  private:
-  // The state the matrix depends on, besides the bonds (invalidate): dt, S_r, k_r, C, rho, J;
-  // the network's points and its B_f (CrackBlock::coupling).
+  // The state the matrix's values depend on, besides the bonds (invalidate): dt, S_r, k_r, C,
+  // rho, J; the network's B_f (CrackBlock::coupling). Its graphs depend on the network's points
+  // and the columns of B_f: structure_ when they changed (the same on every rank).
   static constexpr std::size_t kSeen = 5;
   bool needs_assembly(double dt, const FluidState<Dim>& st, const SkeletonState& sk,
                       const CrackBlock& crack) {
     const auto& p = disc_.points;
     const std::size_t n = p.n_owned;
-    int flags[2] = {stale_ || dt != dt_ ? 1 : 0, crack.point.empty() ? 0 : 1};
+    int flags[4] = {stale_ || dt != dt_ ? 1 : 0, crack.point.empty() ? 0 : 1, 0, 0};
     int& changed = flags[0];
+    int& structure = flags[2];
+    int& geometry = flags[3];  // the bonds or B_f changed: B_0, Gr and their transposes
+    structure = composed_.matrix().is_null() || crack.point != crack_points_ ||
+                crack.held != crack_held_ || columns(crack.coupling) != crack_columns_;
+    geometry = structure || stale_ || crack.coupling != crack_coupling_;
+    changed = changed || geometry;
     for (std::size_t i = 0; i < n && !changed; ++i)
       changed = seen_[kSeen * i] != p.saturation(i) || seen_[kSeen * i + 1] != p.rel_perm(i) ||
                 seen_[kSeen * i + 2] != sk.density(i) || seen_[kSeen * i + 3] != sk.inertia(i) ||
                 seen_[kSeen * i + 4] != st.storage(i);
-    if (!changed)
-      changed = crack.point != crack_points_ || crack.held != crack_held_ ||
-                crack.coupling != crack_coupling_;
-    MPI_Allreduce(MPI_IN_PLACE, flags, 2, MPI_INT, MPI_MAX, comm_);
+    MPI_Allreduce(MPI_IN_PLACE, flags, 4, MPI_INT, MPI_MAX, comm_);
     any_crack_ = flags[1] != 0;
+    structure_ = structure != 0;
+    geometry_ = geometry != 0;
     return changed != 0;
+  }
+  static std::vector<std::vector<GlobalId>> columns(
+      const std::vector<std::vector<std::pair<GlobalId, double>>>& rows) {
+    std::vector<std::vector<GlobalId>> out(rows.size());
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      for (const auto& e : rows[k])
+        out[k].push_back(e.first);
+    return out;
   }
 
   // CG where the system is symmetric: without image points (S_H = S_P = R in assemble, and the
   // network's rows are symmetric: Lambda_ij = Lambda_ji, the exchange on both sides); GMRES
   // with images (an image's row and column differ). The same choice on every rank.
-  static LinearSolveSettings krylov(LinearSolveSettings s, const std::vector<PressureRole>& roles,
-                                    MPI_Comm comm) {
+  static bool any_images(const std::vector<PressureRole>& roles, MPI_Comm comm) {
     int images = 0;
     for (const PressureRole r : roles)
       images |= r == PressureRole::OddImage || r == PressureRole::EvenImage;
     MPI_Allreduce(MPI_IN_PLACE, &images, 1, MPI_INT, MPI_MAX, comm);
+    return images != 0;
+  }
+  static LinearSolveSettings krylov(LinearSolveSettings s, bool images) {
     s.method = images ? "GMRES" : "CG";
     return s;
   }
 
   // system_ = composed_ + ns (ns the network's rows of the step, R N S_H) on a graph kept while
-  // ns's pattern and composed_ do not change: the values are written in place (composed_'s,
-  // then ns's added: the same sums on every step, whether the graph is new or kept, so a
-  // restart, which builds it again, gives the same matrix) and the preconditioner's numeric
-  // part alone is computed again when the refresh interval is up (LinearSolve::refresh).
+  // ns's pattern and composed_'s graph do not change: the values are written in place
+  // (composed_'s, then ns's added: the same sums on every step, whether the graph is new or
+  // kept, so a restart, which builds it again, gives the same matrix) and the preconditioner's
+  // numeric part alone is computed again when the refresh interval is up
+  // (LinearSolve::refresh).
   void compose(const CrsMatrix& ns) {
     ScopedRegion region("mupm::Pressure::compose");
     const auto nl = ns.getLocalMatrixHost();
@@ -410,11 +440,12 @@ class PressureProjection {
         pattern.push_back(joint_->getGlobalElement(r));
         pattern.push_back(ncols.getGlobalElement(nl.graph.entries(q)));
       }
-    int rebuild = system_.is_null() || system_ == composed_ || pattern != pattern_ ? 1 : 0;
+    const auto& composed = composed_.matrix();
+    int rebuild = system_.is_null() || system_ == composed || pattern != pattern_ ? 1 : 0;
     MPI_Allreduce(MPI_IN_PLACE, &rebuild, 1, MPI_INT, MPI_MAX, comm_);
     if (rebuild) {
-      system_ = Tpetra::MatrixMatrix::add(1.0, false, *composed_, 1.0, false, ns);
-      if (!system_->getRowMap()->isSameAs(*joint_) || !composed_->getRowMap()->isSameAs(*joint_))
+      system_ = Tpetra::MatrixMatrix::add(1.0, false, *composed, 1.0, false, ns);
+      if (!system_->getRowMap()->isSameAs(*joint_) || !composed->getRowMap()->isSameAs(*joint_))
         throw std::logic_error("PressureProjection::compose: the rows are not the joint map's");
       const auto sl = system_->getLocalMatrixHost();
       const auto& scols = *system_->getColMap();
@@ -425,12 +456,12 @@ class PressureProjection {
             return std::size_t(q);
         throw std::logic_error("PressureProjection::compose: an entry is not in the sum's graph");
       };
-      base_.assign(sl.values.extent(0), 0.0);
-      const auto cl = composed_->getLocalMatrixHost();
-      const auto& ccols = *composed_->getColMap();
+      const auto cl = composed->getLocalMatrixHost();
+      const auto& ccols = *composed->getColMap();
+      base_.resize(cl.values.extent(0));
       for (LocalId r = 0; r < LocalId(cl.numRows()); ++r)
         for (auto q = cl.graph.row_map(r); q < cl.graph.row_map(r + 1); ++q)
-          base_[at(r, ccols.getGlobalElement(cl.graph.entries(q)))] = cl.values(q);
+          base_[std::size_t(q)] = at(r, ccols.getGlobalElement(cl.graph.entries(q)));
       where_.resize(nl.values.extent(0));
       for (std::size_t q = 0; q < where_.size(); ++q)
         where_[q] = at(joint_->getLocalElement(pattern[2 * q]), pattern[2 * q + 1]);
@@ -438,8 +469,11 @@ class PressureProjection {
     }
     {
       const auto v = system_->getLocalValuesView();
+      const auto cv = composed->getLocalValuesView();
+      for (std::size_t q = 0; q < v.extent(0); ++q)
+        v(q) = 0.0;
       for (std::size_t q = 0; q < base_.size(); ++q)
-        v(q) = base_[q];
+        v(base_[q]) = cv(q);
       for (std::size_t q = 0; q < where_.size(); ++q)
         v(where_[q]) += nl.values(q);
     }
@@ -483,9 +517,13 @@ class PressureProjection {
     return a;
   }
 
+  // The system's graphs (structure_: built again) and values. Every value comes from the
+  // kept-graph operations (include/mupm/solvers/kept_matrix.hpp) whether the graph is new or
+  // kept: a restart, which builds the graphs, gives the straight run's matrix.
   void assemble(double dt, const FluidParams& prm, const FluidState<Dim>& st,
                 const SkeletonState& sk, const CrackBlock& crack) {
-    ScopedRegion region("mupm::Pressure::assemble");
+    const bool build = structure_;
+    ScopedRegion region(build ? "mupm::Pressure::assemble" : "mupm::Pressure::refill");
     auto& p = disc_.points;
     const std::size_t n = p.n_owned, m = crack.point.size();
     seen_.resize(kSeen * n);
@@ -499,8 +537,9 @@ class PressureProjection {
     crack_points_ = crack.point;
     crack_held_ = crack.held;
     crack_coupling_ = crack.coupling;
+    crack_columns_ = columns(crack.coupling);
     // The joint map: the owned points' pore pressures, then their fracture pressures.
-    {
+    if (build) {
       std::vector<GlobalId> ids(n + m);
       for (std::size_t i = 0; i < n; ++i)
         ids[i] = p.gid(i);
@@ -514,14 +553,41 @@ class PressureProjection {
     Scalars alpha("mupm::projection_alpha", p.size());
     Kokkos::deep_copy(alpha, st.alpha);
     add_pressure_stabilization(disc_, prm, dt, sk.density, alpha);
-    flow_ = assemble_flow_operator(disc_, prm, alpha);
-    coupling_ = assemble_volume_coupling(disc_, prm.pore.biot);
-    std::vector<std::pair<GlobalId, std::vector<std::pair<GlobalId, double>>>> extra;
+    GlobalRows extra;
     for (std::size_t k = 0; k < m; ++k)
       extra.push_back({offset_ + p.gid(crack.point[k]), crack.coupling[k]});
-    const auto flow = detail::with_rows(flow_.get(), joint_, {}, joint_, joint_);
-    joint_coupling_ = detail::with_rows(coupling_.get(), joint_, extra, dofs_, joint_);
-    inverse_mass_ = Teuchos::rcp(new TpetraVector(dofs_));
+    if (build) {
+      flow_.build(disc_, prm, alpha);
+      coupling_.build(disc_, prm.pore.biot);
+      joint_flow_.build(flow_.matrix().get(), joint_, {}, joint_, joint_);
+      joint_coupling_.build(coupling_.matrix().get(), joint_, extra, dofs_, joint_);
+      inverse_mass_ = Teuchos::rcp(new TpetraVector(dofs_));
+      saturation_ = Teuchos::rcp(new TpetraVector(disc_.dist.owned_map()));
+      sigma_ = Teuchos::rcp(new TpetraVector(joint_));
+    } else {
+      flow_.fill(disc_, prm, alpha, geometry_);
+      joint_flow_.fill(flow_.matrix().get(), {});
+      if (geometry_) {
+        coupling_.fill(disc_, prm.pore.biot);
+        joint_coupling_.fill(coupling_.matrix().get(), extra);
+      }
+    }
+    // B = diag(sigma) [B_0; B_f]: sigma = S_r on the points' rows, 1 on the network's.
+    {
+      auto sv = saturation_->getLocalViewHost(Tpetra::Access::OverwriteAll);
+      auto gv = sigma_->getLocalViewHost(Tpetra::Access::OverwriteAll);
+      for (std::size_t i = 0; i < n; ++i)
+        sv(i, 0) = gv(i, 0) = p.saturation(i);
+      for (std::size_t k = 0; k < m; ++k)
+        gv(n + k, 0) = 1.0;
+    }
+    const auto& jc = *joint_coupling_.matrix();
+    if (build)
+      coupling_s_ = Teuchos::rcp(new CrsMatrix(jc, Teuchos::Copy));
+    Kokkos::deep_copy(coupling_s_->getLocalValuesView(), jc.getLocalValuesView());
+    coupling_s_->leftScale(*sigma_);
+    if (geometry_)
+      coupling_t_ = transpose(joint_coupling_.matrix());  // [B_0; B_f]^T
     TpetraVector storage(joint_);
     {
       auto mv = inverse_mass_->getLocalViewHost(Tpetra::Access::OverwriteAll);
@@ -537,10 +603,26 @@ class PressureProjection {
       for (std::size_t k = 0; k < m; ++k)
         sv(n + k, 0) = 0.0;  // the network's storage is in its rows of the step
     }
-    const auto projection = projection_operator(*joint_coupling_, *inverse_mass_);
-    const auto rest = Tpetra::MatrixMatrix::add(dt * dt, false, *projection, 1.0, false,
-                                                *diagonal_matrix(storage));
-    static_ = Tpetra::MatrixMatrix::add(dt, false, *flow, 1.0, false, *rest);
+    // B M^-1 B^T = (B M^-1) [B_0; B_f]^T diag(sigma): B M^-1 a copy of B's values on its graph,
+    // scaled; the transpose kept while the bonds and B_f do not change.
+    if (build)
+      scaled_coupling_ = Teuchos::rcp(new CrsMatrix(jc, Teuchos::Copy));
+    Kokkos::deep_copy(scaled_coupling_->getLocalValuesView(), coupling_s_->getLocalValuesView());
+    scaled_coupling_->rightScale(*inverse_mass_);
+    const auto& flow = *joint_flow_.matrix();
+    if (build) {
+      projection_.build(*scaled_coupling_, false, *coupling_t_, false);
+      projection_.matrix()->rightScale(*sigma_);
+      storage_.build(storage);
+      rest_.build(dt * dt, *projection_.matrix(), 1.0, *storage_.matrix());
+      static_.build(dt, flow, 1.0, *rest_.matrix());
+    } else {
+      projection_.fill(*scaled_coupling_, false, *coupling_t_, false);
+      projection_.matrix()->rightScale(*sigma_);
+      storage_.fill(storage);
+      rest_.fill(dt * dt, *projection_.matrix(), 1.0, *storage_.matrix());
+      static_.fill(dt, flow, 1.0, *rest_.matrix());
+    }
     // The pressure increment is S x + c (x the solve's unknowns, c the held and lagged image
     // increments). S_H: the images follow their mirrors' increments (odd or even), for the flow;
     // S_P: they do not, for the skeleton's response within the step. An image's pressure reaches
@@ -551,35 +633,39 @@ class PressureProjection {
     // compression within the same solve, a coupling no water balance books). The system is
     // R (dt V H S_H + (dt^2 P + V C) S_P + N S_H) + D_c, N the network's rows of the step: R keeps
     // the free rows, D_c puts the mean free diagonal on the others. A fracture pressure is free
-    // unless held, and has no image.
-    std::vector<std::vector<std::pair<GlobalId, double>>> rows(n + m), free_rows(n + m);
-    keep_ = Teuchos::rcp(new TpetraVector(joint_));
+    // unless held, and has no image. A point that may be free has its entry in S_H and S_P
+    // (1 where free, else 0: the graphs do not follow the values).
+    if (build)
+      keep_ = Teuchos::rcp(new TpetraVector(joint_));
     TpetraVector diag(joint_), other(joint_);
-    static_->getLocalDiagCopy(diag);
+    static_.matrix()->getLocalDiagCopy(diag);
     // A free point whose row is empty (it lost all its bonds, and its water has no storage:
     // incompressible) keeps its pressure: dp = 0, a row of the mean diagonal.
     double sum[2] = {0, 0};
     solved_.assign(n + m, 0);
+    GlobalRows srows(n + m), frows(n + m);
     {
       auto kv = keep_->getLocalViewHost(Tpetra::Access::OverwriteAll);
       auto dv = diag.getLocalViewHost(Tpetra::Access::ReadOnly);
       for (std::size_t i = 0; i < n + m; ++i) {
         const bool bulk = i < n;
         const GlobalId g = bulk ? p.gid(i) : offset_ + p.gid(crack.point[i - n]);
-        const bool free =
-            bulk ? roles_[i] == PressureRole::Free && dv(i, 0) > 0 : !crack.held[i - n];
+        srows[i].first = frows[i].first = g;
+        const bool may = bulk ? roles_[i] == PressureRole::Free : !crack.held[i - n];
+        const bool free = may && (!bulk || dv(i, 0) > 0);
         solved_[i] = free ? 1 : 0;
         kv(i, 0) = free ? 1.0 : 0.0;
-        if (free) {
-          rows[i].push_back({g, 1.0});
-          free_rows[i].push_back({g, 1.0});
-          if (bulk) {
+        if (may) {
+          srows[i].second.push_back({g, free ? 1.0 : 0.0});
+          frows[i].second.push_back({g, free ? 1.0 : 0.0});
+          if (bulk && free) {
             sum[0] += dv(i, 0);
             sum[1] += 1;
           }
         } else if (bulk &&
                    (roles_[i] == PressureRole::OddImage || roles_[i] == PressureRole::EvenImage)) {
-          rows[i].push_back({p.gid(images_[i]), roles_[i] == PressureRole::OddImage ? -1.0 : 1.0});
+          srows[i].second.push_back(
+              {p.gid(images_[i]), roles_[i] == PressureRole::OddImage ? -1.0 : 1.0});
         }
       }
     }
@@ -590,28 +676,50 @@ class PressureProjection {
       for (std::size_t i = 0; i < n + m; ++i)
         ov(i, 0) = solved_[i] ? 0.0 : mean;
     }
-    std::vector<std::pair<GlobalId, std::vector<std::pair<GlobalId, double>>>> srows, frows;
-    for (std::size_t i = 0; i < n + m; ++i) {
-      const GlobalId g = i < n ? p.gid(i) : offset_ + p.gid(crack.point[i - n]);
-      srows.push_back({g, rows[i]});
-      frows.push_back({g, free_rows[i]});
+    if (build) {
+      s_h_.build(nullptr, joint_, srows, joint_, joint_);
+      s_p_.build(nullptr, joint_, frows, joint_, joint_);
+    } else {
+      s_h_.fill(nullptr, srows);
+      s_p_.fill(nullptr, frows);
     }
-    images_matrix_ = detail::with_rows(nullptr, joint_, srows, joint_, joint_);
-    free_matrix_ = detail::with_rows(nullptr, joint_, frows, joint_, joint_);
-    auto flow_s = Teuchos::rcp(new CrsMatrix(joint_, 0)),
-         rest_s = Teuchos::rcp(new CrsMatrix(joint_, 0));
-    Tpetra::MatrixMatrix::Multiply(*flow, false, *images_matrix_, false, *flow_s);
-    Tpetra::MatrixMatrix::Multiply(*rest, false, *free_matrix_, false, *rest_s);
-    auto ras = Tpetra::MatrixMatrix::add(dt, false, *flow_s, 1.0, false, *rest_s);
+    // Without images S_H = S_P = diag(keep) (1 on the free rows, 0 on the others), so
+    // R (dt V H S_H + (dt^2 P + V C) S_P) is static_ scaled by keep on both sides: no products.
+    Teuchos::RCP<CrsMatrix> ras;
+    if (!images_any_) {
+      if (build)
+        scaled_static_ = Teuchos::rcp(new CrsMatrix(*static_.matrix(), Teuchos::Copy));
+      Kokkos::deep_copy(scaled_static_->getLocalValuesView(),
+                        static_.matrix()->getLocalValuesView());
+      scaled_static_->rightScale(*keep_);
+      ras = scaled_static_;
+    } else if (build) {
+      flow_s_.build(flow, false, *s_h_.matrix(), false);
+      rest_s_.build(*rest_.matrix(), false, *s_p_.matrix(), false);
+      ras_.build(dt, *flow_s_.matrix(), 1.0, *rest_s_.matrix());
+      ras = ras_.matrix();
+    } else {
+      flow_s_.fill(flow, false, *s_h_.matrix(), false);
+      rest_s_.fill(*rest_.matrix(), false, *s_p_.matrix(), false);
+      ras_.fill(dt, *flow_s_.matrix(), 1.0, *rest_s_.matrix());
+      ras = ras_.matrix();
+    }
     ras->leftScale(*keep_);
-    composed_ = Tpetra::MatrixMatrix::add(1.0, false, *ras, 1.0, false, *diagonal_matrix(other));
-    system_ = Teuchos::null;
+    if (build) {
+      other_.build(other);
+      composed_.build(1.0, *ras, 1.0, *other_.matrix());
+      system_ = Teuchos::null;
+    } else {
+      other_.fill(other);
+      composed_.fill(1.0, *ras, 1.0, *other_.matrix());
+    }
     dt_ = dt;
     stale_ = false;
     ++assemblies_;
   }
 
   Discretization<Dim>& disc_;
+  bool images_any_;  // image points on some rank (the system is not symmetric)
   LinearSolve solver_;
   std::vector<PressureRole> roles_;
   std::vector<LocalId> images_;
@@ -621,17 +729,26 @@ class PressureProjection {
   Teuchos::RCP<const Map> dofs_, joint_;
   // flow_, coupling_: over the points; the others over the joint map (static_: the system's
   // rows but the network's of the step, before R and S; composed_: after them).
-  Teuchos::RCP<CrsMatrix> flow_, coupling_, joint_coupling_, static_, images_matrix_, free_matrix_,
-      composed_, system_;
-  Teuchos::RCP<TpetraVector> inverse_mass_, keep_;
+  FlowOperator<Dim> flow_;
+  VolumeCoupling<Dim> coupling_;
+  KeptJoin joint_flow_, joint_coupling_, s_h_, s_p_;  // s_h_, s_p_: S_H, S_P of assemble
+  KeptProduct projection_, flow_s_, rest_s_;
+  KeptDiagonal storage_, other_;
+  KeptSum rest_, static_, ras_, composed_;
+  // coupling_: B_0 over the points; joint_coupling_: [B_0; B_f]; coupling_s_: B, its rows
+  // scaled by sigma_ (S_r, 1 on the network's rows); coupling_t_: [B_0; B_f]^T
+  Teuchos::RCP<CrsMatrix> coupling_s_, coupling_t_, scaled_coupling_, scaled_static_, system_;
+  Teuchos::RCP<TpetraVector> inverse_mass_, keep_, saturation_, sigma_;
   std::vector<double> seen_;
-  // compose: ns's pattern, composed_'s values in system_'s storage, ns's entries' positions
+  // compose: ns's pattern, composed_'s entries' positions in system_, ns's entries' positions
   std::vector<GlobalId> pattern_;
-  std::vector<double> base_;
+  std::vector<std::size_t> base_;
   std::vector<std::size_t> where_;
   std::vector<LocalId> crack_points_;
   std::vector<char> crack_held_;
   std::vector<std::vector<std::pair<GlobalId, double>>> crack_coupling_;
+  std::vector<std::vector<GlobalId>> crack_columns_;
+  bool structure_ = true, geometry_ = true;
   bool any_crack_ = false;
   double dt_ = 0;
   bool stale_ = true;

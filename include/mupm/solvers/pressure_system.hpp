@@ -44,6 +44,7 @@
 #include "mupm/core/small_matrix.hpp"
 #include "mupm/kernels/fluid.hpp"
 #include "mupm/mesh/discretization.hpp"
+#include "mupm/solvers/kept_matrix.hpp"
 #include "mupm/solvers/linear_solve.hpp"
 
 namespace mupm {
@@ -63,33 +64,117 @@ Teuchos::RCP<const Map> component_map(const Discretization<Dim>& disc, int ncomp
       new Map(invalid, Teuchos::ArrayView<const GlobalId>(ids), 0, disc.dist.comm()));
 }
 
-namespace detail {
-// A matrix with the given maps, from rows of (local column, value), owned rows in order.
-inline Teuchos::RCP<CrsMatrix> from_rows(
-    const Teuchos::RCP<const Map>& rows, const Teuchos::RCP<const Map>& cols,
-    const Teuchos::RCP<const Map>& domain, const Teuchos::RCP<const Map>& range,
-    const std::vector<std::vector<std::pair<LocalId, double>>>& entries) {
-  std::size_t longest = 1;
-  for (const auto& r : entries)
-    longest = std::max(longest, r.size());
-  auto a = Teuchos::rcp(new CrsMatrix(rows, cols, longest));
-  std::vector<LocalId> c;
-  std::vector<double> v;
-  for (std::size_t r = 0; r < entries.size(); ++r) {
-    c.clear();
-    v.clear();
-    for (const auto& e : entries[r]) {
-      c.push_back(e.first);
-      v.push_back(e.second);
+// The factors of V H (header, 1): the gradient Gr, W Gr and the graph Laplacian L, over every
+// bond in the lists (a broken bond's entries and a singular point's gradient are zero, so the
+// graphs do not change when bonds break: include/mupm/solvers/kept_matrix.hpp), with the
+// stabilization coefficients `alpha` (owned + ghosts) and the points' current k_r.
+struct FlowRows {
+  LocalRows gr, wgr, lap;
+};
+template <int Dim>
+void flow_rows(const Discretization<Dim>& disc, const FluidParams& prm, const Scalars& alpha,
+               FlowRows& out) {
+  const auto& p = disc.points;
+  const auto& b = disc.bonds;
+  const auto& sh = disc.shape;
+  const std::size_t n = p.n_owned;
+  out.gr.assign(n * Dim, {});
+  out.wgr.assign(n * Dim, {});
+  out.lap.assign(n, {});
+  for (std::size_t i = 0; i < n; ++i) {
+    const double vi = p.volume(i), ai = alpha(i);
+    double self_lap = 0;
+    const bool singular = sh.singular(i) != 0;
+    double Kinv[Dim * Dim], K[Dim * Dim], W[Dim * Dim] = {};
+    for (int k = 0; k < Dim * Dim; ++k)
+      Kinv[k] = sh.Kinv(i, k);
+    auto& lap = out.lap[i];
+    std::vector<std::pair<LocalId, double>> row[Dim];
+    double self[Dim] = {};
+    for (BondIndex e = b.offsets(i); e < b.offsets(i + 1); ++e) {
+      const LocalId j = b.neighbor(e);
+      const bool intact = b.intact(e) != 0;
+      const double vj = p.volume(j);
+      const double w = intact ? vi * vj * (ai + alpha(j)) : 0.0;
+      lap.push_back({j, -w});
+      self_lap += w;
+      double c[Dim] = {};
+      if (intact && !singular) {
+        double xi[Dim];
+        for (int d = 0; d < Dim; ++d)
+          xi[d] = p.x(j, d) - p.x(i, d);
+        mat_vec<Dim, Dim>(Kinv, xi, c);
+      }
+      for (int d = 0; d < Dim; ++d) {
+        row[d].push_back({j, c[d] * vj});
+        self[d] -= c[d] * vj;
+      }
     }
-    if (!c.empty())
-      a->insertLocalValues(LocalId(r), Teuchos::ArrayView<const LocalId>(c),
-                           Teuchos::ArrayView<const double>(v));
+    lap.push_back({LocalId(i), self_lap});
+    if (!singular) {
+      invert<Dim>(Kinv, K);
+      const double lambda = p.rel_perm(i) * prm.mobility;
+      for (int r = 0; r < Dim; ++r)
+        for (int c = 0; c < Dim; ++c)
+          W[r * Dim + c] = vi * ((r == c ? lambda : 0.0) - ai * K[r * Dim + c]);
+    }
+    for (int d = 0; d < Dim; ++d) {
+      row[d].push_back({LocalId(i), self[d]});
+      out.gr[i * Dim + d] = row[d];
+    }
+    // W Gr: row (i, d) = sum_e W_de Gr(i, e); the rows share their columns.
+    for (int d = 0; d < Dim; ++d) {
+      auto& w = out.wgr[i * Dim + d];
+      w = row[0];
+      for (std::size_t k = 0; k < w.size(); ++k) {
+        double s = 0;
+        for (int e2 = 0; e2 < Dim; ++e2)
+          s += W[d * Dim + e2] * row[e2][k].second;
+        w[k].second = s;
+      }
+    }
   }
-  a->fillComplete(domain, range);
-  return a;
 }
-}  // namespace detail
+
+// V H = Gr^T W Gr + L on kept graphs (build, then fill with new alpha, k_r or bonds' state).
+// Gr^T is kept as a matrix and transposed again only when the bonds changed (`geometry`): the
+// product then needs no transpose when only W (k_r, alpha) changed.
+template <int Dim>
+class FlowOperator {
+ public:
+  void build(const Discretization<Dim>& disc, const FluidParams& prm, const Scalars& alpha) {
+    flow_rows(disc, prm, alpha, rows_);
+    const auto grad_map = component_map(disc, Dim, false);
+    const auto& owned = disc.dist.owned_map();
+    const auto& overlap = disc.dist.overlap_map();
+    g_.build(grad_map, overlap, owned, grad_map, rows_.gr);
+    wg_.build(grad_map, overlap, owned, grad_map, rows_.wgr);
+    l_.build(owned, overlap, owned, owned, rows_.lap);
+    gt_ = transpose(g_.matrix());
+    flux_.build(*gt_, false, *wg_.matrix(), false);
+    sum_.build(1.0, *flux_.matrix(), 1.0, *l_.matrix());
+  }
+  void fill(const Discretization<Dim>& disc, const FluidParams& prm, const Scalars& alpha,
+            bool geometry) {
+    flow_rows(disc, prm, alpha, rows_);
+    if (geometry) {
+      g_.fill(rows_.gr);
+      gt_ = transpose(g_.matrix());
+    }
+    wg_.fill(rows_.wgr);
+    l_.fill(rows_.lap);
+    flux_.fill(*gt_, false, *wg_.matrix(), false);
+    sum_.fill(1.0, *flux_.matrix(), 1.0, *l_.matrix());
+  }
+  const Teuchos::RCP<CrsMatrix>& matrix() const { return sum_.matrix(); }
+
+ private:
+  FlowRows rows_;
+  KeptRows g_, wg_, l_;
+  Teuchos::RCP<CrsMatrix> gt_;
+  KeptProduct flux_;
+  KeptSum sum_;
+};
 
 // V H (header, 1) with the stabilization coefficients `alpha` (owned + ghosts: the fluid
 // state's alpha after FluidSolver's evaluate(), or more, pressure_projection.hpp) and the
@@ -97,72 +182,9 @@ inline Teuchos::RCP<CrsMatrix> from_rows(
 template <int Dim>
 Teuchos::RCP<CrsMatrix> assemble_flow_operator(const Discretization<Dim>& disc,
                                                const FluidParams& prm, const Scalars& alpha) {
-  const auto& p = disc.points;
-  const auto& b = disc.bonds;
-  const auto& sh = disc.shape;
-  const auto grad_map = component_map(disc, Dim, false);
-  const auto& owned = disc.dist.owned_map();
-  const auto& overlap = disc.dist.overlap_map();
-  const std::size_t n = p.n_owned;
-  std::vector<std::vector<std::pair<LocalId, double>>> gr(n * Dim), wgr(n * Dim), lap(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double vi = p.volume(i), ai = alpha(i);
-    double self_lap = 0;
-    const bool singular = sh.singular(i) != 0;
-    double Kinv[Dim * Dim], K[Dim * Dim], W[Dim * Dim];
-    for (int k = 0; k < Dim * Dim; ++k)
-      Kinv[k] = sh.Kinv(i, k);
-    std::vector<std::pair<LocalId, double>> row[Dim];
-    double self[Dim] = {};
-    for (BondIndex e = b.offsets(i); e < b.offsets(i + 1); ++e) {
-      if (!b.intact(e))
-        continue;
-      const LocalId j = b.neighbor(e);
-      const double vj = p.volume(j);
-      const double w = vi * vj * (ai + alpha(j));
-      lap[i].push_back({j, -w});
-      self_lap += w;
-      if (singular)
-        continue;
-      double xi[Dim], c[Dim];
-      for (int d = 0; d < Dim; ++d)
-        xi[d] = p.x(j, d) - p.x(i, d);
-      mat_vec<Dim, Dim>(Kinv, xi, c);
-      for (int d = 0; d < Dim; ++d) {
-        row[d].push_back({j, c[d] * vj});
-        self[d] -= c[d] * vj;
-      }
-    }
-    lap[i].push_back({LocalId(i), self_lap});
-    if (singular)
-      continue;
-    invert<Dim>(Kinv, K);
-    const double lambda = p.rel_perm(i) * prm.mobility;
-    for (int r = 0; r < Dim; ++r)
-      for (int c = 0; c < Dim; ++c)
-        W[r * Dim + c] = vi * ((r == c ? lambda : 0.0) - ai * K[r * Dim + c]);
-    for (int d = 0; d < Dim; ++d) {
-      row[d].push_back({LocalId(i), self[d]});
-      gr[i * Dim + d] = row[d];
-    }
-    // W Gr: row (i, d) = sum_e W_de Gr(i, e); the rows share their columns.
-    for (int d = 0; d < Dim; ++d) {
-      auto& out = wgr[i * Dim + d];
-      out = row[0];
-      for (std::size_t k = 0; k < out.size(); ++k) {
-        double s = 0;
-        for (int e2 = 0; e2 < Dim; ++e2)
-          s += W[d * Dim + e2] * row[e2][k].second;
-        out[k].second = s;
-      }
-    }
-  }
-  const auto G = detail::from_rows(grad_map, overlap, owned, grad_map, gr);
-  const auto WG = detail::from_rows(grad_map, overlap, owned, grad_map, wgr);
-  const auto L = detail::from_rows(owned, overlap, owned, owned, lap);
-  auto flux = Teuchos::rcp(new CrsMatrix(owned, 0));
-  Tpetra::MatrixMatrix::Multiply(*G, true, *WG, false, *flux);
-  return Tpetra::MatrixMatrix::add(1.0, false, *flux, 1.0, false, *L);
+  FlowOperator<Dim> h;
+  h.build(disc, prm, alpha);
+  return h.matrix();
 }
 
 // The pressure stabilization of the semi-implicit step (derivation in pressure_projection.hpp):
@@ -182,36 +204,39 @@ void add_pressure_stabilization(Discretization<Dim>& disc, const FluidParams& pr
   disc.dist.refresh({as_vectors(alpha)});
 }
 
-// B~ (header, 2), over the owned points (rows) and their (u, theta) components (columns:
-// component_map(disc, Dim + R, ...)).
+// The rows of B~ (header, 2) over every bond in the lists (zero for a broken bond and on a
+// singular point, so that the graph does not change when bonds break), columns in the
+// component map over the owned and ghost points (component_map(disc, Dim + R, true)).
 template <int Dim>
-Teuchos::RCP<CrsMatrix> assemble_volume_coupling(const Discretization<Dim>& disc, double biot = 1) {
+void volume_coupling_rows(const Discretization<Dim>& disc, double biot, bool saturation,
+                          LocalRows& rows) {
   constexpr int R = kRotDim<Dim>, NC = Dim + R;
   const auto& p = disc.points;
   const auto& b = disc.bonds;
   const auto& sh = disc.shape;
-  const auto dofs = component_map(disc, NC, false), dofs_all = component_map(disc, NC, true);
   const std::size_t n = p.n_owned;
-  std::vector<std::vector<std::pair<LocalId, double>>> rows(n);
+  rows.assign(n, {});
   for (std::size_t i = 0; i < n; ++i) {
-    if (sh.singular(i) || (p.fixed(i) & kFixedNoEnergy))
+    if (p.fixed(i) & kFixedNoEnergy)
       continue;
-    const double s = p.volume(i) * biot * p.saturation(i);
+    const bool singular = sh.singular(i) != 0;
+    const double s = p.volume(i) * biot * (saturation ? p.saturation(i) : 1.0);
     double Kinv[Dim * Dim];
     for (int k = 0; k < Dim * Dim; ++k)
       Kinv[k] = sh.Kinv(i, k);
     double self[NC] = {};
     auto& row = rows[i];
     for (BondIndex e = b.offsets(i); e < b.offsets(i + 1); ++e) {
-      if (!b.intact(e))
-        continue;
       const LocalId j = b.neighbor(e);
       const double vj = p.volume(j);
-      double xi[Dim], c[Dim], rot[R];
-      for (int d = 0; d < Dim; ++d)
-        xi[d] = p.x(j, d) - p.x(i, d);
-      mat_vec<Dim, Dim>(Kinv, xi, c);
-      cross<Dim>(xi, c, rot);
+      double c[Dim] = {}, rot[R] = {};
+      if (b.intact(e) && !singular) {
+        double xi[Dim];
+        for (int d = 0; d < Dim; ++d)
+          xi[d] = p.x(j, d) - p.x(i, d);
+        mat_vec<Dim, Dim>(Kinv, xi, c);
+        cross<Dim>(xi, c, rot);
+      }
       for (int d = 0; d < Dim; ++d) {
         row.push_back({LocalId(j * NC + d), s * vj * c[d]});
         self[d] -= s * vj * c[d];
@@ -225,7 +250,41 @@ Teuchos::RCP<CrsMatrix> assemble_volume_coupling(const Discretization<Dim>& disc
     for (int k = 0; k < NC; ++k)
       row.push_back({LocalId(i * NC + std::size_t(k)), self[k]});
   }
-  return detail::from_rows(disc.dist.owned_map(), dofs_all, dofs, disc.dist.owned_map(), rows);
+}
+
+// B~ (header, 2) without its factor S_r (B_0, B~ = diag(S_r) B_0: the graph and values that
+// change with the bonds only) on a kept graph, over the owned points (rows) and their
+// (u, theta) components (columns: component_map(disc, Dim + R, ...)).
+template <int Dim>
+class VolumeCoupling {
+ public:
+  void build(const Discretization<Dim>& disc, double biot) {
+    constexpr int NC = Dim + kRotDim<Dim>;
+    volume_coupling_rows(disc, biot, false, rows_);
+    m_.build(disc.dist.owned_map(), component_map(disc, NC, true), component_map(disc, NC, false),
+             disc.dist.owned_map(), rows_);
+  }
+  void fill(const Discretization<Dim>& disc, double biot) {
+    volume_coupling_rows(disc, biot, false, rows_);
+    m_.fill(rows_);
+  }
+  const Teuchos::RCP<CrsMatrix>& matrix() const { return m_.matrix(); }
+
+ private:
+  LocalRows rows_;
+  KeptRows m_;
+};
+
+// B~ (header, 2).
+template <int Dim>
+Teuchos::RCP<CrsMatrix> assemble_volume_coupling(const Discretization<Dim>& disc, double biot = 1) {
+  constexpr int NC = Dim + kRotDim<Dim>;
+  LocalRows rows;
+  volume_coupling_rows(disc, biot, true, rows);
+  KeptRows b;
+  b.build(disc.dist.owned_map(), component_map(disc, NC, true), component_map(disc, NC, false),
+          disc.dist.owned_map(), rows);
+  return b.matrix();
 }
 
 // B~ M^-1 B~^T (header, 3); `inverse_mass` on the owned components (0 where prescribed).
@@ -260,67 +319,6 @@ struct CrackBlock {
   // component_map(disc, Dim + R, ...)) [m^2]; empty rows without the face pressure
   std::vector<std::vector<std::pair<GlobalId, double>>> coupling;
 };
-
-namespace detail {
-// `a`'s rows (none: no rows) under their global ids, plus `extra` rows (global row, (global
-// column, value)), as a matrix over `rows` (which holds both) with the given domain and range.
-inline Teuchos::RCP<CrsMatrix> with_rows(
-    const CrsMatrix* a, const Teuchos::RCP<const Map>& rows,
-    const std::vector<std::pair<GlobalId, std::vector<std::pair<GlobalId, double>>>>& extra,
-    const Teuchos::RCP<const Map>& domain, const Teuchos::RCP<const Map>& range) {
-  std::size_t longest = a ? std::max<std::size_t>(1, a->getNodeMaxNumRowEntries()) : 1;
-  for (const auto& r : extra)
-    longest = std::max(longest, r.second.size());
-  auto out = Teuchos::rcp(new CrsMatrix(rows, longest));
-  std::vector<GlobalId> cols;
-  std::vector<double> vals;
-  const LocalId nrows = a ? LocalId(a->getRowMap()->getNodeNumElements()) : 0;
-  for (LocalId r = 0; r < nrows; ++r) {
-    const auto& arows = *a->getRowMap();
-    const auto& acols = *a->getColMap();
-    CrsMatrix::local_inds_host_view_type idx;
-    CrsMatrix::values_host_view_type v;
-    a->getLocalRowView(r, idx, v);
-    cols.resize(idx.extent(0));
-    vals.resize(idx.extent(0));
-    for (std::size_t k = 0; k < idx.extent(0); ++k) {
-      cols[k] = acols.getGlobalElement(idx(k));
-      vals[k] = v(k);
-    }
-    if (!cols.empty())
-      out->insertGlobalValues(arows.getGlobalElement(r), Teuchos::ArrayView<const GlobalId>(cols),
-                              Teuchos::ArrayView<const double>(vals));
-  }
-  for (const auto& r : extra) {
-    cols.clear();
-    vals.clear();
-    for (const auto& e : r.second) {
-      cols.push_back(e.first);
-      vals.push_back(e.second);
-    }
-    if (!cols.empty())
-      out->insertGlobalValues(r.first, Teuchos::ArrayView<const GlobalId>(cols),
-                              Teuchos::ArrayView<const double>(vals));
-  }
-  out->fillComplete(domain, range);
-  return out;
-}
-}  // namespace detail
-
-// A diagonal matrix over `map` with the values of `diag`.
-inline Teuchos::RCP<CrsMatrix> diagonal_matrix(const TpetraVector& diag) {
-  const auto map = diag.getMap();
-  auto a = Teuchos::rcp(new CrsMatrix(map, map, 1));
-  auto d = diag.getLocalViewHost(Tpetra::Access::ReadOnly);
-  for (LocalId r = 0; r < LocalId(map->getNodeNumElements()); ++r) {
-    const LocalId c = r;
-    const double v = d(r, 0);
-    a->insertLocalValues(r, Teuchos::ArrayView<const LocalId>(&c, 1),
-                         Teuchos::ArrayView<const double>(&v, 1));
-  }
-  a->fillComplete(map, map);
-  return a;
-}
 
 }  // namespace mupm
 
