@@ -9,6 +9,7 @@
 #include <string>
 
 #include "mupm/core/stop.hpp"
+#include "mupm/core/version.hpp"
 #include "mupm/input/input.hpp"
 #include "mupm/input/model.hpp"
 #include "mupm/io/checkpoint.hpp"
@@ -21,6 +22,7 @@ const char* kUsage =
     "usage: mupm INPUT.xml              run the simulation described by INPUT.xml\n"
     "       mupm --validate INPUT.xml   check the input only (exit 0 when valid)\n"
     "       mupm --print-defaults       print every parameter with its default and doc string\n"
+    "       mupm --version              the version, git revision and build configuration\n"
     "       mupm --help                 this text\n"
     "Parallel: mpirun -np R mupm INPUT.xml, with OMP_NUM_THREADS=T threads per rank\n"
     "(also OMP_PROC_BIND=spread OMP_PLACES=threads). Kokkos options (--kokkos-...) are accepted.\n"
@@ -101,6 +103,10 @@ int main(int argc, char* argv[]) {
       continue;  // Kokkos' own options, taken by Kokkos when it starts
     } else if (a == "--help" || a == "-h") {
       mode = "help";
+    } else if (a == "--version") {
+      if (first)
+        std::cout << mupm::version_text();
+      return 0;
     } else if (a == "--print-defaults") {
       mode = "defaults";
     } else if (a == "--validate") {
