@@ -1,12 +1,14 @@
 // The assembled operators of the semi-implicit pressure step (include/mupm/solvers/
 // pressure_system.hpp) against the kernels they stand for, on 1 and 2 ranks: the flow operator
-// and the coupling (volumetric strain, pressure force and moment). The step itself is tested
+// and the coupling (volumetric strain, pressure force and moment), and their values refilled on
+// kept graphs after breakage against a fresh build. The step itself is tested
 // against closed forms in tests/solvers/test_fluid_solver.cpp (FluidSolverSemiImplicit,
 // FluidSolverLong.TerzaghiSemiImplicit*) and tests/cli/semi_implicit.sh.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "mupm/input/model.hpp"
 #include "mupm/solvers/fluid_solver.hpp"
@@ -102,6 +104,98 @@ void check_flow_operator() {
   const double xhz = xv.dot(hz), zhx = z.dot(y);
   EXPECT_NEAR(xhz, zhx, 1e-12 * std::abs(xhz));
   EXPECT_GT(xv.dot(y), 0) << "positive semi-definite: x . H x >= 0";
+}
+
+// Each entry of a against b's at the same global row and column, to the bit (the same graph).
+bool same_entries(const CrsMatrix& a, const CrsMatrix& b) {
+  bool same = a.getNodeNumEntries() == b.getNodeNumEntries();
+  for (LocalId r = 0; same && r < LocalId(a.getRowMap()->getNodeNumElements()); ++r) {
+    const GlobalId g = a.getRowMap()->getGlobalElement(r);
+    CrsMatrix::local_inds_host_view_type ia, ib;
+    CrsMatrix::values_host_view_type va, vb;
+    a.getLocalRowView(r, ia, va);
+    b.getLocalRowView(b.getRowMap()->getLocalElement(g), ib, vb);
+    std::map<GlobalId, double> row;
+    for (std::size_t k = 0; k < ia.extent(0); ++k)
+      row[a.getColMap()->getGlobalElement(ia(k))] = va(k);
+    same = ib.extent(0) == ia.extent(0);
+    for (std::size_t k = 0; same && k < ib.extent(0); ++k) {
+      const auto it = row.find(b.getColMap()->getGlobalElement(ib(k)));
+      same = it != row.end() && it->second == vb(k);
+    }
+  }
+  int all = same ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  return all == 1;
+}
+
+// The kept graphs (include/mupm/solvers/kept_matrix.hpp): the flow operator and the coupling
+// built on an intact, nearly saturated body, then refilled after bonds break (every bond across
+// x = x0, at both ends) and S_r, k_r and alpha change, equal a fresh build on the new state to
+// the bit (what a restart builds), and the refilled flow operator is the fluid's divergence over
+// the intact bonds, as the fresh one on an intact body is (FlowOperatorIsTheFluidsDivergence).
+TEST(PressureProjection, KeptGraphsRefilledAfterBreakageEqualAFreshBuild) {
+  auto disc = discretize(test::world(), test::box<2>({12, 9}, 3.015));
+  auto& p = disc.points;
+  Kokkos::deep_copy(p.porosity, 0.3);
+  auto fp = fluid_params(disc.grid, 1e-9, 0.5);
+  fp.retention = VanGenuchten::mualem(2e4, 1.8);
+  FluidState<2> st;
+  st.allocate(p.size(), p.n_owned);
+  fill(p, as_vectors(p.p));
+  Kokkos::parallel_for(
+      range(0, p.size()), KOKKOS_LAMBDA(const std::size_t i) { p.p(i) *= -1e3; });
+  fluid_constitutive(p, fp, st);
+  FlowOperator<2> h;
+  h.build(disc, fp, st.alpha);
+  VolumeCoupling<2> b;
+  b.build(disc, 0.8);
+  // Break every bond across x0 (a geometric rule: both ends on every rank agree).
+  const double x0 = disc.grid.origin[0] + 5.5 * disc.grid.dx;
+  long long broken = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    for (BondIndex e = disc.bonds.offsets(i); e < disc.bonds.offsets(i + 1); ++e) {
+      const LocalId j = disc.bonds.neighbor(e);
+      if ((p.x(i, 0) - x0) * (p.x(j, 0) - x0) < 0) {
+        disc.bonds.intact(e) = 0;
+        ++broken;
+      }
+    }
+  MPI_Allreduce(MPI_IN_PLACE, &broken, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  ASSERT_GT(broken, 100);
+  disc.update_shape();
+  // Drier: S_r, k_r and alpha change.
+  Kokkos::parallel_for(
+      range(0, p.size()), KOKKOS_LAMBDA(const std::size_t i) { p.p(i) *= 30; });
+  fluid_constitutive(p, fp, st);
+  Scalars x("x", p.size());
+  fill(p, as_vectors(x), 5);
+  fluid_flow(disc, fp, st, x, false);
+  h.fill(disc, fp, st.alpha, true);
+  b.fill(disc, 0.8);
+  FlowOperator<2> h_fresh;
+  h_fresh.build(disc, fp, st.alpha);
+  VolumeCoupling<2> b_fresh;
+  b_fresh.build(disc, 0.8);
+  EXPECT_TRUE(same_entries(*h.matrix(), *h_fresh.matrix()));
+  EXPECT_TRUE(same_entries(*b.matrix(), *b_fresh.matrix()));
+  // A refill that leaves the bonds (geometry = false: the kept transpose of the gradient).
+  h.fill(disc, fp, st.alpha, false);
+  EXPECT_TRUE(same_entries(*h.matrix(), *h_fresh.matrix()));
+  TpetraVector xv(disc.dist.owned_map()), y(disc.dist.owned_map());
+  {
+    auto v = xv.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < p.n_owned; ++i)
+      v(i, 0) = x(i);
+  }
+  h.matrix()->apply(xv, y);
+  std::vector<double> got(p.n_owned), want(p.n_owned);
+  auto yv = y.getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    got[i] = yv(i, 0);
+    want[i] = p.volume(i) * st.flow(i);
+  }
+  EXPECT_LT(relative_difference(got, want), 1e-12);
 }
 
 TEST(PressureProjection, FlowOperatorIsTheFluidsDivergence2D) {
