@@ -752,11 +752,24 @@ TEST(FluidSolverSemiImplicit, TightSoilIncompressibleTakesTheLoad) {
 // `time`. 16 spacings: the strips of opposite faces' consistent loads (2 delta + dx deep) must
 // not overlap.
 struct SealedBody {
-  static constexpr double dx = 0.01, L = 16 * dx, q = 1e4;
+  static constexpr double dx = 0.01, L = 16 * dx, q = 1e4, phi = 0.3;
   GridSpec<2> g = test::box<2>({16, 16}, 3.015, dx);
   Discretization<2> disc;
   static MicropolarElastic material() {
     return MicropolarElastic::from_bulk_shear(10e6, 6e6, 3e6, 0.01);
+  }
+  // The drained plane-stress wave speed of material() with the saturated mixture's density.
+  static double drained_wave_speed() {
+    const MicropolarElastic m = material();
+    const double rho = (1 - phi) * 2000 + phi * 1000;
+    return std::sqrt(4 * m.mu * (m.lambda + m.mu) / (m.lambda + 2 * m.mu) / rho);
+  }
+  // A ramp of the load over `transits` transits of that wave across the body.
+  static TimeFunction ramp(double transits) {
+    TimeFunction r;
+    r.kind = TimeFunction::Ramp;
+    r.ramp_time = transits * L / drained_wave_speed();
+    return r;
   }
   MicropolarElastic law = material();  // in plane stress, its plane_stress()
   std::vector<BoundaryCondition> bcs;
@@ -777,7 +790,7 @@ struct SealedBody {
     g.regions = {box2(-1, 0.5 * dx, -1, 1), box2(L - 0.5 * dx, 1, -1, 1), box2(-1, 1, -1, 0.5 * dx),
                  box2(-1, 1, L - 0.5 * dx, 1)};
     disc = discretize(test::world(), g);
-    Kokkos::deep_copy(disc.points.porosity, 0.3);
+    Kokkos::deep_copy(disc.points.porosity, phi);
     Kokkos::deep_copy(disc.points.saturation, 1.0);
     for (int face = 0; face < 4; ++face) {
       BoundaryCondition bc;
@@ -876,15 +889,11 @@ TEST(FluidSolverSemiImplicit, SealedIncompressibleBodyTakesTheLoad) {
 // form, for the semi-implicit water (incompressible) and the explicit one (K_w / phi = 10 (lambda +
 // 2 mu): the undrained split and the fluid's storage with the thickness's compliance).
 TEST(FluidSolverHydroMechanical, SealedBodyPlaneStress) {
-  const double q = SealedBody::q, L = SealedBody::L;
-  const MicropolarElastic law3 = SealedBody::material();
-  const double lam = law3.lambda, mu = law3.mu, phi = 0.3;
-  const double rho = (1 - phi) * 2000 + phi * 1000;
-  const double c_d = std::sqrt(4 * mu * (lam + mu) / (lam + 2 * mu) / rho);
-  const double t_r = 10 * L / c_d;
-  TimeFunction ramp;
-  ramp.kind = TimeFunction::Ramp;
-  ramp.ramp_time = t_r;
+  const double q = SealedBody::q, L = SealedBody::L, phi = SealedBody::phi;
+  const double lam = SealedBody::material().lambda, mu = SealedBody::material().mu;
+  const double c_d = SealedBody::drained_wave_speed();
+  const TimeFunction ramp = SealedBody::ramp(10);
+  const double t_r = ramp.ramp_time;
   for (const bool explicit_water : {false, true}) {
     const double k_w =
         explicit_water ? 10 * (lam + 2 * mu) * phi : std::numeric_limits<double>::infinity();
@@ -937,15 +946,11 @@ TEST(FluidSolverHydroMechanical, SealedBodyPlaneStress) {
 // into the yielded body and the mean p is 0.23-0.25 q in all three runs; over 40 and 160, within
 // 0.3 % of the closed form).
 TEST(FluidSolverHydroMechanical, SealedBodyPlaneStressDruckerPrager) {
-  const double q = SealedBody::q, L = SealedBody::L;
-  const MicropolarElastic law3 = SealedBody::material();
-  const double lam = law3.lambda, mu = law3.mu, phi = 0.3;
-  const double rho = (1 - phi) * 2000 + phi * 1000;
-  const double c_d = std::sqrt(4 * mu * (lam + mu) / (lam + 2 * mu) / rho);
-  const double t_r = 40 * L / c_d;
-  TimeFunction ramp;
-  ramp.kind = TimeFunction::Ramp;
-  ramp.ramp_time = t_r;
+  const double q = SealedBody::q, L = SealedBody::L, phi = SealedBody::phi;
+  const double lam = SealedBody::material().lambda, mu = SealedBody::material().mu;
+  const double c_d = SealedBody::drained_wave_speed();
+  const TimeFunction ramp = SealedBody::ramp(40);
+  const double t_r = ramp.ramp_time;
   DruckerPragerParams dp;
   dp.friction = 30 * kPi / 180;
   dp.dilation = 10 * kPi / 180;
