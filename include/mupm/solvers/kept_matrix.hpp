@@ -90,10 +90,26 @@ inline void add_values(CrsMatrix& c, double s, const CrsMatrix& a,
   if (av.extent(0) != pos.size())
     throw std::logic_error("KeptMatrix: a summand's graph changed");
   if (first)
-    for (std::size_t q = 0; q < v.extent(0); ++q)
-      v(q) = 0.0;
+    Kokkos::deep_copy(v, 0.0);
   for (std::size_t q = 0; q < pos.size(); ++q)
     v(pos[q]) += s * av(q);
+}
+
+// c's values += the listed rows' values at `pos` (in the rows' order; entries(r) gives a row's
+// (column, value) pairs), which must be as many as at build.
+template <class Rows, class Entries>
+void add_listed(CrsMatrix& c, const std::vector<std::size_t>& pos, const Rows& rows,
+                Entries&& entries) {
+  const auto v = c.getLocalValuesView();
+  std::size_t k = 0;
+  for (const auto& r : rows)
+    for (const auto& e : entries(r)) {
+      if (k == pos.size())
+        throw std::logic_error("KeptMatrix: the listed rows' graph changed");
+      v(pos[k++]) += e.second;
+    }
+  if (k != pos.size())
+    throw std::logic_error("KeptMatrix: the listed rows' graph changed");
 }
 }  // namespace detail
 
@@ -128,18 +144,9 @@ class KeptRows {
     fill(entries);
   }
   void fill(const LocalRows& entries) {
-    const auto v = m_->getLocalValuesView();
-    for (std::size_t q = 0; q < v.extent(0); ++q)
-      v(q) = 0.0;
-    std::size_t k = 0;
-    for (const auto& r : entries)
-      for (const auto& e : r) {
-        if (k == pos_.size())
-          throw std::logic_error("KeptRows: the rows' graph changed");
-        v(pos_[k++]) += e.second;
-      }
-    if (k != pos_.size())
-      throw std::logic_error("KeptRows: the rows' graph changed");
+    Kokkos::deep_copy(m_->getLocalValuesView(), 0.0);
+    detail::add_listed(
+        *m_, pos_, entries, [](const auto& r) -> const auto& { return r; });
   }
   const Teuchos::RCP<CrsMatrix>& matrix() const { return m_; }
 
@@ -211,21 +218,12 @@ class KeptJoin {
     fill(a, extra);
   }
   void fill(const CrsMatrix* a, const GlobalRows& extra) {
-    const auto v = m_->getLocalValuesView();
     if (a)
       detail::add_values(*m_, 1.0, *a, pa_, true);
     else
-      for (std::size_t q = 0; q < v.extent(0); ++q)
-        v(q) = 0.0;
-    std::size_t k = 0;
-    for (const auto& r : extra)
-      for (const auto& e : r.second) {
-        if (k == pe_.size())
-          throw std::logic_error("KeptJoin: the extra rows' graph changed");
-        v(pe_[k++]) += e.second;
-      }
-    if (k != pe_.size())
-      throw std::logic_error("KeptJoin: the extra rows' graph changed");
+      Kokkos::deep_copy(m_->getLocalValuesView(), 0.0);
+    detail::add_listed(
+        *m_, pe_, extra, [](const auto& r) -> const auto& { return r.second; });
   }
   const Teuchos::RCP<CrsMatrix>& matrix() const { return m_; }
 
@@ -247,6 +245,10 @@ class KeptSum {
     detail::add_values(*m_, s, a, pa_, true);
     detail::add_values(*m_, t, b, pb_, false);
   }
+  // build() when `graph` (a new graph), else fill().
+  void update(bool graph, double s, const CrsMatrix& a, double t, const CrsMatrix& b) {
+    graph ? build(s, a, t, b) : fill(s, a, t, b);
+  }
   const Teuchos::RCP<CrsMatrix>& matrix() const { return m_; }
 
  private:
@@ -266,11 +268,21 @@ class KeptProduct {
   void fill(const CrsMatrix& a, bool ta, const CrsMatrix& b, bool tb) {
     Tpetra::MatrixMatrix::Multiply(a, ta, b, tb, *m_);
   }
+  void update(bool graph, const CrsMatrix& a, bool ta, const CrsMatrix& b, bool tb) {
+    graph ? build(a, ta, b, tb) : fill(a, ta, b, tb);
+  }
   const Teuchos::RCP<CrsMatrix>& matrix() const { return m_; }
 
  private:
   Teuchos::RCP<CrsMatrix> m_;
 };
+
+// dst: src's values on a copy of src's graph (copied when `graph`: a new graph).
+inline void copy_values(Teuchos::RCP<CrsMatrix>& dst, const CrsMatrix& src, bool graph) {
+  if (graph)
+    dst = Teuchos::rcp(new CrsMatrix(src, Teuchos::Copy));
+  Kokkos::deep_copy(dst->getLocalValuesView(), src.getLocalValuesView());
+}
 
 // a^T (Tpetra's transposer; its graph follows a's, so a product that takes it keeps its own).
 inline Teuchos::RCP<CrsMatrix> transpose(const Teuchos::RCP<const CrsMatrix>& a) {
@@ -300,6 +312,7 @@ class KeptDiagonal {
     for (LocalId r = 0; r < LocalId(l.numRows()); ++r)
       v(l.graph.row_map(r)) = dv(r, 0);
   }
+  void update(bool graph, const TpetraVector& d) { graph ? build(d) : fill(d); }
   const Teuchos::RCP<CrsMatrix>& matrix() const { return m_; }
 
  private:

@@ -169,6 +169,7 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -386,7 +387,7 @@ class PressureProjection {
     int& structure = flags[2];
     int& geometry = flags[3];  // the bonds or B_f changed: B_0, Gr and their transposes
     structure = composed_.matrix().is_null() || crack.point != crack_points_ ||
-                crack.held != crack_held_ || columns(crack.coupling) != crack_columns_;
+                crack.held != crack_held_ || !same_columns(crack.coupling, crack_coupling_);
     geometry = structure || stale_ || crack.coupling != crack_coupling_;
     changed = changed || geometry;
     for (std::size_t i = 0; i < n && !changed; ++i)
@@ -399,13 +400,16 @@ class PressureProjection {
     geometry_ = geometry != 0;
     return changed != 0;
   }
-  static std::vector<std::vector<GlobalId>> columns(
-      const std::vector<std::vector<std::pair<GlobalId, double>>>& rows) {
-    std::vector<std::vector<GlobalId>> out(rows.size());
-    for (std::size_t k = 0; k < rows.size(); ++k)
-      for (const auto& e : rows[k])
-        out[k].push_back(e.first);
-    return out;
+  // Whether two sets of B_f rows have the same columns (values aside).
+  static bool same_columns(const std::vector<std::vector<std::pair<GlobalId, double>>>& a,
+                           const std::vector<std::vector<std::pair<GlobalId, double>>>& b) {
+    if (a.size() != b.size())
+      return false;
+    for (std::size_t k = 0; k < a.size(); ++k)
+      if (!std::equal(a[k].begin(), a[k].end(), b[k].begin(), b[k].end(),
+                      [](const auto& x, const auto& y) { return x.first == y.first; }))
+        return false;
+    return true;
   }
 
   // CG where the system is symmetric: without image points (S_H = S_P = R in assemble, and the
@@ -537,7 +541,6 @@ class PressureProjection {
     crack_points_ = crack.point;
     crack_held_ = crack.held;
     crack_coupling_ = crack.coupling;
-    crack_columns_ = columns(crack.coupling);
     // The joint map: the owned points' pore pressures, then their fracture pressures.
     if (build) {
       std::vector<GlobalId> ids(n + m);
@@ -581,10 +584,7 @@ class PressureProjection {
       for (std::size_t k = 0; k < m; ++k)
         gv(n + k, 0) = 1.0;
     }
-    const auto& jc = *joint_coupling_.matrix();
-    if (build)
-      coupling_s_ = Teuchos::rcp(new CrsMatrix(jc, Teuchos::Copy));
-    Kokkos::deep_copy(coupling_s_->getLocalValuesView(), jc.getLocalValuesView());
+    copy_values(coupling_s_, *joint_coupling_.matrix(), build);
     coupling_s_->leftScale(*sigma_);
     if (geometry_)
       coupling_t_ = transpose(joint_coupling_.matrix());  // [B_0; B_f]^T
@@ -605,24 +605,14 @@ class PressureProjection {
     }
     // B M^-1 B^T = (B M^-1) [B_0; B_f]^T diag(sigma): B M^-1 a copy of B's values on its graph,
     // scaled; the transpose kept while the bonds and B_f do not change.
-    if (build)
-      scaled_coupling_ = Teuchos::rcp(new CrsMatrix(jc, Teuchos::Copy));
-    Kokkos::deep_copy(scaled_coupling_->getLocalValuesView(), coupling_s_->getLocalValuesView());
+    copy_values(scaled_coupling_, *coupling_s_, build);
     scaled_coupling_->rightScale(*inverse_mass_);
     const auto& flow = *joint_flow_.matrix();
-    if (build) {
-      projection_.build(*scaled_coupling_, false, *coupling_t_, false);
-      projection_.matrix()->rightScale(*sigma_);
-      storage_.build(storage);
-      rest_.build(dt * dt, *projection_.matrix(), 1.0, *storage_.matrix());
-      static_.build(dt, flow, 1.0, *rest_.matrix());
-    } else {
-      projection_.fill(*scaled_coupling_, false, *coupling_t_, false);
-      projection_.matrix()->rightScale(*sigma_);
-      storage_.fill(storage);
-      rest_.fill(dt * dt, *projection_.matrix(), 1.0, *storage_.matrix());
-      static_.fill(dt, flow, 1.0, *rest_.matrix());
-    }
+    projection_.update(build, *scaled_coupling_, false, *coupling_t_, false);
+    projection_.matrix()->rightScale(*sigma_);
+    storage_.update(build, storage);
+    rest_.update(build, dt * dt, *projection_.matrix(), 1.0, *storage_.matrix());
+    static_.update(build, dt, flow, 1.0, *rest_.matrix());
     // The pressure increment is S x + c (x the solve's unknowns, c the held and lagged image
     // increments). S_H: the images follow their mirrors' increments (odd or even), for the flow;
     // S_P: they do not, for the skeleton's response within the step. An image's pressure reaches
@@ -687,32 +677,20 @@ class PressureProjection {
     // R (dt V H S_H + (dt^2 P + V C) S_P) is static_ scaled by keep on both sides: no products.
     Teuchos::RCP<CrsMatrix> ras;
     if (!images_any_) {
-      if (build)
-        scaled_static_ = Teuchos::rcp(new CrsMatrix(*static_.matrix(), Teuchos::Copy));
-      Kokkos::deep_copy(scaled_static_->getLocalValuesView(),
-                        static_.matrix()->getLocalValuesView());
+      copy_values(scaled_static_, *static_.matrix(), build);
       scaled_static_->rightScale(*keep_);
       ras = scaled_static_;
-    } else if (build) {
-      flow_s_.build(flow, false, *s_h_.matrix(), false);
-      rest_s_.build(*rest_.matrix(), false, *s_p_.matrix(), false);
-      ras_.build(dt, *flow_s_.matrix(), 1.0, *rest_s_.matrix());
-      ras = ras_.matrix();
     } else {
-      flow_s_.fill(flow, false, *s_h_.matrix(), false);
-      rest_s_.fill(*rest_.matrix(), false, *s_p_.matrix(), false);
-      ras_.fill(dt, *flow_s_.matrix(), 1.0, *rest_s_.matrix());
+      flow_s_.update(build, flow, false, *s_h_.matrix(), false);
+      rest_s_.update(build, *rest_.matrix(), false, *s_p_.matrix(), false);
+      ras_.update(build, dt, *flow_s_.matrix(), 1.0, *rest_s_.matrix());
       ras = ras_.matrix();
     }
     ras->leftScale(*keep_);
-    if (build) {
-      other_.build(other);
-      composed_.build(1.0, *ras, 1.0, *other_.matrix());
+    other_.update(build, other);
+    composed_.update(build, 1.0, *ras, 1.0, *other_.matrix());
+    if (build)
       system_ = Teuchos::null;
-    } else {
-      other_.fill(other);
-      composed_.fill(1.0, *ras, 1.0, *other_.matrix());
-    }
     dt_ = dt;
     stale_ = false;
     ++assemblies_;
@@ -747,7 +725,6 @@ class PressureProjection {
   std::vector<LocalId> crack_points_;
   std::vector<char> crack_held_;
   std::vector<std::vector<std::pair<GlobalId, double>>> crack_coupling_;
-  std::vector<std::vector<GlobalId>> crack_columns_;
   bool structure_ = true, geometry_ = true;
   bool any_crack_ = false;
   double dt_ = 0;
