@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <unordered_map>
 
 namespace mupm::timers {
@@ -19,6 +20,8 @@ struct State {
   std::vector<Entry> entries;
   std::vector<std::pair<std::size_t, Clock::time_point>> kernels, regions;  // open ones
   bool enabled = false;
+  bool in_loop = false;                                        // time_loop(true) .. (false)
+  std::map<std::string, std::pair<long long, double>> allocs;  // in the loop: count, bytes
 };
 State& state() {
   static State s;
@@ -68,7 +71,20 @@ void pop_region() {
   ++s.entries[k].calls;
 }
 
+void allocate(Kokkos::Tools::SpaceHandle, const char* label, const void*, std::uint64_t bytes) {
+  State& s = state();
+  if (!s.in_loop)
+    return;
+  auto& a = s.allocs[label && *label ? label : "(unlabelled)"];
+  ++a.first;
+  a.second += double(bytes);
+}
+
 }  // namespace
+
+void time_loop(bool inside) {
+  state().in_loop = inside;
+}
 
 bool enable() {
   if (std::getenv("KOKKOS_TOOLS_LIBS") || std::getenv("KOKKOS_PROFILE_LIBRARY"))
@@ -82,6 +98,7 @@ bool enable() {
   KT::set_end_parallel_scan_callback(end_kernel);
   KT::set_push_region_callback(push_region);
   KT::set_pop_region_callback(pop_region);
+  KT::set_allocate_data_callback(allocate);
   state().enabled = true;
   return true;
 }
@@ -98,6 +115,7 @@ void disable() {
   KT::set_end_parallel_scan_callback(nullptr);
   KT::set_push_region_callback(nullptr);
   KT::set_pop_region_callback(nullptr);
+  KT::set_allocate_data_callback(nullptr);
   state().enabled = false;
 }
 
@@ -107,6 +125,7 @@ void reset() {
     e.seconds = 0;
     e.calls = 0;
   }
+  s.allocs.clear();
 }
 
 std::vector<Entry> local_entries() {
@@ -144,6 +163,10 @@ void report(MPI_Comm comm, std::ostream& out) {
   const int n = static_cast<int>(rows.size());
   MPI_Reduce(t.data(), tmin.data(), n, MPI_DOUBLE, MPI_MIN, 0, comm);
   MPI_Reduce(t.data(), tmax.data(), n, MPI_DOUBLE, MPI_MAX, 0, comm);
+  long long allocs = 0, max_allocs = 0;
+  for (const auto& a : state().allocs)
+    allocs += a.second.first;
+  MPI_Reduce(&allocs, &max_allocs, 1, MPI_LONG_LONG, MPI_MAX, 0, comm);
   if (rank != 0)
     return;
   std::vector<std::size_t> order(rows.size());
@@ -164,6 +187,15 @@ void report(MPI_Comm comm, std::ostream& out) {
                   tmax[r]);
     out << line;
   }
+  // Views allocated between time_loop(true) and time_loop(false): a time loop should allocate
+  // none (each allocation is a system call and a fill, and a device backend would serialize).
+  out << "View allocations in the time loop: " << max_allocs << " (most on a rank)";
+  if (!state().allocs.empty()) {
+    out << "; rank 0's by label (count, MiB):";
+    for (const auto& a : state().allocs)
+      out << "\n  " << a.first << " " << a.second.first << " " << a.second.second / 1048576.0;
+  }
+  out << "\n";
 }
 
 }  // namespace mupm::timers

@@ -16,6 +16,16 @@ Distribution::Distribution(const Teuchos::RCP<const Comm>& comm, const std::vect
   importer_ = Teuchos::rcp(new Import(owned_map_, overlap_map_));
 }
 
+Distribution::Buffers& Distribution::buffers(std::map<std::size_t, Buffers>& kept,
+                                             std::size_t width) const {
+  Buffers& b = kept[width];
+  if (b.owned.is_null()) {
+    b.owned = Teuchos::rcp(new MultiVector(owned_map_, width, false));
+    b.overlap = Teuchos::rcp(new MultiVector(overlap_map_, width, false));
+  }
+  return b;
+}
+
 void Distribution::refresh(const std::vector<Vectors>& fields) {
   ScopedRegion region("mupm::Comm::ghost_refresh");
   std::size_t width = 0;
@@ -23,13 +33,10 @@ void Distribution::refresh(const std::vector<Vectors>& fields) {
     width += f.extent(1);
   if (width == 0)
     return;
-  if (owned_buf_.is_null() || owned_buf_->getNumVectors() != width) {
-    owned_buf_ = Teuchos::rcp(new MultiVector(owned_map_, width, false));
-    overlap_buf_ = Teuchos::rcp(new MultiVector(overlap_map_, width, false));
-  }
+  const Buffers& bufs = buffers(refresh_bufs_, width);
   const std::size_t n_own = n_owned_, n_gh = n_ghost_;
   {
-    auto buf = owned_buf_->getLocalViewDevice(Tpetra::Access::OverwriteAll);
+    auto buf = bufs.owned->getLocalViewDevice(Tpetra::Access::OverwriteAll);
     std::size_t col = 0;
     for (const auto& f : fields) {
       const std::size_t nc = f.extent(1), c0 = col;
@@ -41,9 +48,9 @@ void Distribution::refresh(const std::vector<Vectors>& fields) {
       col += nc;
     }
   }
-  overlap_buf_->doImport(*owned_buf_, *importer_, Tpetra::INSERT);
+  bufs.overlap->doImport(*bufs.owned, *importer_, Tpetra::INSERT);
   {
-    auto buf = overlap_buf_->getLocalViewDevice(Tpetra::Access::ReadOnly);
+    auto buf = bufs.overlap->getLocalViewDevice(Tpetra::Access::ReadOnly);
     std::size_t col = 0;
     for (const auto& f : fields) {
       const std::size_t nc = f.extent(1), c0 = col;
@@ -64,23 +71,20 @@ void Distribution::add_to_owners(const Vectors& buf) {
   const std::size_t width = buf.extent(1);
   if (width == 0)
     return;
-  if (sum_owned_.is_null() || sum_owned_->getNumVectors() != width) {
-    sum_owned_ = Teuchos::rcp(new MultiVector(owned_map_, width, false));
-    sum_overlap_ = Teuchos::rcp(new MultiVector(overlap_map_, width, false));
-  }
+  const Buffers& bufs = buffers(sum_bufs_, width);
   const std::size_t n_own = n_owned_, n_all = n_owned_ + n_ghost_;
   {
-    auto b = sum_overlap_->getLocalViewDevice(Tpetra::Access::OverwriteAll);
+    auto b = bufs.overlap->getLocalViewDevice(Tpetra::Access::OverwriteAll);
     Kokkos::parallel_for(
         "mupm::Comm::pack_sum", range(0, n_all), KOKKOS_LAMBDA(const std::size_t i) {
           for (std::size_t c = 0; c < width; ++c)
             b(i, c) = buf(i, c);
         });
   }
-  sum_owned_->putScalar(0.0);
-  sum_owned_->doExport(*sum_overlap_, *importer_, Tpetra::ADD);
+  bufs.owned->putScalar(0.0);
+  bufs.owned->doExport(*bufs.overlap, *importer_, Tpetra::ADD);
   {
-    auto b = sum_owned_->getLocalViewDevice(Tpetra::Access::ReadOnly);
+    auto b = bufs.owned->getLocalViewDevice(Tpetra::Access::ReadOnly);
     Kokkos::parallel_for(
         "mupm::Comm::unpack_sum", range(0, n_own), KOKKOS_LAMBDA(const std::size_t i) {
           for (std::size_t c = 0; c < width; ++c)

@@ -93,6 +93,7 @@ struct LinearSolve::Impl {
   Teuchos::RCP<const CrsMatrix> pm;  // the matrix prec was computed from
   Teuchos::RCP<Belos::LinearProblem<double, MV, OP>> problem;
   Teuchos::RCP<Belos::SolverManager<double, MV, OP>> solver;
+  Teuchos::RCP<TpetraVector> x0;  // solve()'s copy of the initial guess, kept while its map is
 };
 
 LinearSolve::LinearSolve(const LinearSolveSettings& settings)
@@ -260,7 +261,10 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
   // ILU is therefore tried again from the same initial guess: with the ILU of this matrix's
   // values where the factors were of earlier ones (refresh_interval), else with Jacobi, kept
   // for this matrix's values. Otherwise a failed solve, for the caller to report.
-  TpetraVector x0(x, Teuchos::Copy);
+  auto& x0 = impl_->x0;
+  if (x0.is_null() || x0->getMap().get() != x.getMap().get())
+    x0 = Teuchos::rcp(new TpetraVector(x.getMap(), false));
+  x0->assign(x);
   for (;;) {
     impl_->solver->setProblem(impl_->problem);
     try {
@@ -283,7 +287,7 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
       fall_back_to_jacobi();
       precondition();
     }
-    x.assign(x0);
+    x.assign(*x0);
     if (!impl_->problem->setProblem())
       throw std::logic_error("LinearSolve: Belos could not set up the problem");
   }

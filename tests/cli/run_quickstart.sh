@@ -8,6 +8,10 @@ grep -q "point-steps/s" run.out || fail "no throughput line"
 grep -q "ETA" run.out || fail "no progress line"
 grep -q "mupm::Solid::pass2" run.out || fail "no kernel time table"
 grep -q "WARNING" run.out && fail "the quick start printed a warning"
+# A step allocates no View (each would be a system call and a fill per step; the buffers of the
+# ghost refreshes are kept by width: include/mupm/mesh/distribution.hpp).
+grep -q "^View allocations in the time loop: 0 " run.out ||
+  fail "the time loop allocated Views: $(grep -A5 '^View allocations' run.out)"
 "$PYTHON" "$SRC/tests/cli/check_xdmf.py" output/fields.xmf
 "$PYTHON" - <<'PY'
 import csv, h5py, numpy as np

@@ -24,6 +24,9 @@ struct Entry {
 bool enable();
 void disable();
 void reset();
+// Marks the time loop: View allocations between time_loop(true) and time_loop(false) are
+// counted by label and reported.
+void time_loop(bool inside);
 std::vector<Entry> local_entries();
 
 // Collective: prints, on rank 0 of comm, one line per label of rank 0 with calls and the min and

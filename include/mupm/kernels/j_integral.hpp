@@ -91,7 +91,7 @@ inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const Sol
   auto x = pts.x, u = pts.u, th = pts.theta;
   auto vol = pts.volume;
   auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, P1w = st.P1w;
-  auto w0 = st.w0, energy = st.energy;
+  auto winv = st.winv, energy = st.energy;
   const bool effective = P1w.extent(0) > 0;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
   const double c2 = prm.stabilization * prm.stab_modulus;
@@ -144,10 +144,10 @@ inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const Sol
                 continue;
               double xi[Dim], Uh[Dim], Om[R];
               const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, Uh, Om);
-              const double len = std::sqrt(len2);
-              const double a1 = c1 / (len2 * len), a2 = c2 / len;
-              const double a1i = w0(i) > 0 ? a1 / w0(i) : 0.0, a2i = w0(i) > 0 ? a2 / w0(i) : 0.0;
-              const double a1j = w0(j) > 0 ? a1 / w0(j) : 0.0, a2j = w0(j) > 0 ? a2 / w0(j) : 0.0;
+              const double il = 1.0 / std::sqrt(len2);
+              const double a1 = c1 * (il * il * il), a2 = c2 * il;  // as solid_pass2
+              const double a1i = a1 * winv(i), a2i = a2 * winv(i);
+              const double a1j = a1 * winv(j), a2j = a2 * winv(j);
               // T_ij = P1_i xi + a1i (U^ - eps_i xi); T_ji = -(P1_j xi + a1j (U^ - eps_j xi)).
               double Tij[Dim], Tji[Dim];
               for (int d = 0; d < Dim; ++d) {

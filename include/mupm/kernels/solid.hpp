@@ -68,7 +68,8 @@ struct SolidState {
   static constexpr int R = kRotDim<Dim>;
   Vectors eps, kappa;  // nonlocal strain and wryness (eqs 50-51), owned + ghosts
   Vectors P1, P2;      // (sigma - S_r p 1 - Q1) K^-1 and (m - Q2) K^-1, owned + ghosts
-  Scalars w0;          // omega_0 / V_H: the family's share of a full family (eq 68)
+  Scalars winv;        // V_H / omega_0, 1 over the family's share of a full family (eq 68);
+                       // 0 where the family is empty or the point carries no energy
   Bytes degenerate;    // 1 where K is singular
   Vectors force;       // force density f_i [n_owned][Dim]
   Vectors moment;      // moment density [n_owned][R]
@@ -92,7 +93,7 @@ struct SolidState {
     kappa = Vectors("mupm::kappa", n_all, R * Dim);
     P1 = Vectors("mupm::P1", n_all, Dim * Dim);
     P2 = Vectors("mupm::P2", n_all, R * Dim);
-    w0 = Scalars("mupm::w0", n_all);
+    winv = Scalars("mupm::inverse_family_share", n_all);
     degenerate = Bytes("mupm::degenerate", n_all);
     force = Vectors("mupm::force", n_owned, Dim);
     moment = Vectors("mupm::moment", n_owned, R);
@@ -106,7 +107,7 @@ struct SolidState {
   }
   // What pass 2 reads from the neighbours, besides u and theta.
   std::vector<Vectors> pass2_ghosts() const {
-    std::vector<Vectors> g{eps, kappa, P1, P2, as_vectors(w0)};
+    std::vector<Vectors> g{eps, kappa, P1, P2, as_vectors(winv)};
     if (P1w.extent(0) > 0)
       g.push_back(P1w);
     if (P1f.extent(0) > 0)
@@ -156,7 +157,7 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
   auto vol = pts.volume, p = pts.p, sr = pts.saturation;
   auto bu = pts.undrained_modulus, ref = pts.vol_strain_ref;
   auto sigma_v = pts.stress, m_v = pts.couple_stress;
-  auto eps_v = st.eps, kap_v = st.kappa, P1 = st.P1, P2 = st.P2, w0_v = st.w0;
+  auto eps_v = st.eps, kap_v = st.kappa, P1 = st.P1, P2 = st.P2, winv = st.winv;
   auto degen = st.degenerate;
   auto energy = st.energy;
   auto pstar = st.pstar;
@@ -187,26 +188,54 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
           }
           for (int k = 0; k < R * Dim; ++k)
             kap_v(i, k) = P2(i, k) = m_v(i, k) = 0;
-          w0_v(i) = 0;  // no stabilization of its own (pass 2 skips w0 = 0)
+          winv(i) = 0;  // no stabilization of its own
           pstar(i) = p(i);
           degen(i) = 0;
           energy(i) = 0;
           return;
         }
-        double A[Dim * Dim] = {}, B[R * Dim] = {};
+        // One loop over the family. Besides A = sum U^ (x) xi V and B = sum Omega (x) xi V (eqs
+        // 50-51) it collects the moments the stabilization needs, with g1 = c1/|xi|^3 and
+        // g2 = c2/|xi| (alpha = g/w0, eqs 66-70):
+        //   Ag = sum g1 U^ (x) xi V, Bg = sum g2 Omega (x) xi V, Mg = sum g xi (x) xi V,
+        //   s1 = sum g1 |U^|^2 V, s2 = sum g2 |Omega|^2 V.
+        // Then Q1 = sum alpha1 (U^ - eps xi) (x) xi V = (Ag - eps Mg1)/w0, Q2 likewise, and
+        // sum alpha1 |U^ - eps xi|^2 V = (s1 - 2 eps:Ag + sum_a eps_a.Mg1.eps_a)/w0: the same
+        // sums as a second loop over the residuals, without visiting the family twice.
+        constexpr int NS = Dim * (Dim + 1) / 2;  // Mg: symmetric, upper triangle by rows
+        double A[Dim * Dim] = {}, B[R * Dim] = {}, Ag[Dim * Dim] = {}, Bg[R * Dim] = {};
+        double Mg1[NS] = {}, Mg2[NS] = {}, s1 = 0, s2 = 0;
         for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
           if (!intact(b))
             continue;
           const int j = neighbor(b);
           const double vj = vol(j);
           double xi[Dim], uh[Dim], om[R];
-          bond_kinematics<Dim>(x, u, th, int(i), j, xi, uh, om);
-          for (int a = 0; a < Dim; ++a)
-            for (int k = 0; k < Dim; ++k)
-              A[a * Dim + k] += uh[a] * xi[k] * vj;  // U^ (x) xi (eq 50)
-          for (int r = 0; r < R; ++r)
-            for (int k = 0; k < Dim; ++k)
-              B[r * Dim + k] += om[r] * xi[k] * vj;  // eq 51
+          const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, uh, om);
+          const double il = 1.0 / std::sqrt(len2);
+          const double g1 = c1 * il * il * il * vj, g2 = c2 * il * vj;
+          double xv[Dim];
+          for (int k = 0; k < Dim; ++k)
+            xv[k] = xi[k] * vj;
+          for (int a = 0; a < Dim; ++a) {
+            s1 += g1 * uh[a] * uh[a];
+            for (int k = 0; k < Dim; ++k) {
+              A[a * Dim + k] += uh[a] * xv[k];  // U^ (x) xi (eq 50)
+              Ag[a * Dim + k] += g1 * uh[a] * xi[k];
+            }
+          }
+          for (int r = 0; r < R; ++r) {
+            s2 += g2 * om[r] * om[r];
+            for (int k = 0; k < Dim; ++k) {
+              B[r * Dim + k] += om[r] * xv[k];  // eq 51
+              Bg[r * Dim + k] += g2 * om[r] * xi[k];
+            }
+          }
+          for (int k = 0, n = 0; k < Dim; ++k)
+            for (int l = k; l < Dim; ++l, ++n) {
+              Mg1[n] += g1 * xi[k] * xi[l];
+              Mg2[n] += g2 * xi[k] * xi[l];
+            }
         }
         double Kinv[Dim * Dim], eps[Dim * Dim] = {}, kap[R * Dim] = {};
         for (int k = 0; k < Dim * Dim; ++k)
@@ -232,36 +261,30 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
         if (singular)
           w = 0;
         const double w0 = wsum * inv_vh;
-        // Stabilization: Q1, Q2 and the energy of the residuals (second bond loop).
+        // Stabilization: Q1, Q2 and the energy of the residuals from the moments (above).
         double Q1[Dim * Dim] = {}, Q2[R * Dim] = {};
         double ws = 0;
+        const double iw = w0 > 0 ? 1.0 / w0 : 0.0;
         if (w0 > 0) {
-          for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
-            if (!intact(b))
-              continue;
-            const int j = neighbor(b);
-            const double vj = vol(j);
-            double xi[Dim], uh[Dim], om[R], r1[Dim], r2[R], ex[Dim], kx[R];
-            const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, uh, om);
-            mat_vec<Dim, Dim>(eps, xi, ex);
-            mat_vec<R, Dim>(kap, xi, kx);
-            const double len = std::sqrt(len2);
-            const double a1 = c1 / (len2 * len * w0), a2 = c2 / (len * w0);  // eqs 66-70
-            for (int d = 0; d < Dim; ++d)
-              r1[d] = uh[d] - ex[d];  // eq 62
-            for (int r = 0; r < R; ++r)
-              r2[r] = om[r] - kx[r];  // eq 63
-            for (int a = 0; a < Dim; ++a) {
-              ws += 0.5 * a1 * r1[a] * r1[a] * vj;
-              for (int k = 0; k < Dim; ++k)
-                Q1[a * Dim + k] += a1 * r1[a] * xi[k] * vj;
+          double M1[Dim * Dim], M2[Dim * Dim];
+          for (int k = 0, n = 0; k < Dim; ++k)
+            for (int l = k; l < Dim; ++l, ++n) {
+              M1[k * Dim + l] = M1[l * Dim + k] = Mg1[n];
+              M2[k * Dim + l] = M2[l * Dim + k] = Mg2[n];
             }
-            for (int r = 0; r < R; ++r) {
-              ws += 0.5 * a2 * r2[r] * r2[r] * vj;
-              for (int k = 0; k < Dim; ++k)
-                Q2[r * Dim + k] += a2 * r2[r] * xi[k] * vj;
-            }
+          double eM[Dim * Dim], kM[R * Dim];
+          mat_mul<Dim, Dim>(eps, M1, eM);
+          mat_mul<R, Dim>(kap, M2, kM);
+          double e1 = s1, e2 = s2;
+          for (int k = 0; k < Dim * Dim; ++k) {
+            Q1[k] = (Ag[k] - eM[k]) * iw;
+            e1 += eps[k] * (eM[k] - 2 * Ag[k]);
           }
+          for (int k = 0; k < R * Dim; ++k) {
+            Q2[k] = (Bg[k] - kM[k]) * iw;
+            e2 += kap[k] * (kM[k] - 2 * Bg[k]);
+          }
+          ws = 0.5 * (e1 + e2) * iw;
         }
         // Total stress sigma-bar - biot S_r p* 1 (eq 46) less the stabilization stress, times K^-1.
         const double bsp = biot * sr(i) * pe;  // PoreCoupling: biot = 1 but in plane stress
@@ -291,7 +314,7 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
           for (int k = 0; k < Dim * Dim; ++k)
             P1f(i, k) = dp * Kinv[k];
         }
-        w0_v(i) = w0;
+        winv(i) = iw;
         pstar(i) = pe;
         degen(i) = singular ? 1 : 0;
         energy(i) = vol(i) * (w + ws);
@@ -301,7 +324,7 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
 // Pass 2 (per owned point, full neighbour list, no atomics): force and moment densities
 // (eqs 105-112): f_i = sum_j (T_ij - T_ji) V_j,
 // l_i = sum_j (M_ij - M_ji) V_j + 1/2 sum_j xi x (T_ij - T_ji) V_j. Needs the ghosts' u, theta,
-// eps, kappa, P1, P2, w0 (and increment, P1w when st.work is on).
+// eps, kappa, P1, P2, winv (and increment, P1w when st.work is on).
 //
 // Bond energy (eq 34), with st.work = Accumulate: per pair of unit volumes,
 // dW = (T_ij - T_ji).dU^ + (M_ij - M_ji).dOmega, integrated over the step by the
@@ -329,7 +352,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   auto pair = bonds.pair_force;
   auto x = pts.x, u = pts.u, th = pts.theta;
   auto vol = pts.volume;
-  auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, w0 = st.w0;
+  auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, winv = st.winv;
   auto inc = st.increment, P1w = st.P1w, wmax = st.max_energy;
   auto P1f = st.P1f, srf = pts.pf_saturation;
   auto fw = st.water_force;
@@ -343,6 +366,17 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   Kokkos::parallel_for(
       "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         double f[Dim] = {}, l[R] = {}, wm = 0, f17[Dim + R] = {};
+        // The owned point's rows, read once (the bond loop's stores could alias them).
+        double P1i[Dim * Dim], ei_[Dim * Dim], P2i[R * Dim], ki_[R * Dim];
+        for (int k = 0; k < Dim * Dim; ++k) {
+          P1i[k] = P1(i, k);
+          ei_[k] = eps(i, k);
+        }
+        for (int k = 0; k < R * Dim; ++k) {
+          P2i[k] = P2(i, k);
+          ki_[k] = kap(i, k);
+        }
+        const double wi_ = winv(i);
         for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
           if (!intact(b))
             continue;
@@ -350,10 +384,9 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           const double vj = vol(j);
           double xi[Dim], Uh[Dim], Om[R];
           const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, Uh, Om);
-          const double len = std::sqrt(len2);
-          const double a1 = c1 / (len2 * len), a2 = c2 / len;
-          const double a1i = w0(i) > 0 ? a1 / w0(i) : 0.0, a2i = w0(i) > 0 ? a2 / w0(i) : 0.0;
-          const double a1j = w0(j) > 0 ? a1 / w0(j) : 0.0, a2j = w0(j) > 0 ? a2 / w0(j) : 0.0;
+          const double il = 1.0 / std::sqrt(len2);
+          const double a1 = c1 * (il * il * il), a2 = c2 * il;  // eqs 66-70 with w0 = 1
+          const double a1i = a1 * wi_, a2i = a2 * wi_, a1j = a1 * winv(j), a2j = a2 * winv(j);
           // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
           //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
           double t[Dim], m[R], cf[Dim] = {};
@@ -376,9 +409,9 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           for (int a = 0; a < Dim; ++a) {
             double pi = 0, pj = 0, ei = 0, ej = 0;
             for (int k = 0; k < Dim; ++k) {
-              pi += P1(i, a * Dim + k) * xi[k];
+              pi += P1i[a * Dim + k] * xi[k];
               pj += P1(j, a * Dim + k) * xi[k];
-              ei += eps(i, a * Dim + k) * xi[k];
+              ei += ei_[a * Dim + k] * xi[k];
               ej += eps(j, a * Dim + k) * xi[k];
             }
             t[a] = ((pi + pj) + (a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej))) + cf[a];
@@ -388,9 +421,9 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           for (int r = 0; r < R; ++r) {
             double pi = 0, pj = 0, ki = 0, kj = 0;
             for (int k = 0; k < Dim; ++k) {
-              pi += P2(i, r * Dim + k) * xi[k];
+              pi += P2i[r * Dim + k] * xi[k];
               pj += P2(j, r * Dim + k) * xi[k];
-              ki += kap(i, r * Dim + k) * xi[k];
+              ki += ki_[r * Dim + k] * xi[k];
               kj += kap(j, r * Dim + k) * xi[k];
             }
             m[r] = (pi + pj) + (a2i * (Om[r] - ki) + a2j * (Om[r] - kj));
@@ -445,7 +478,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
 // Pass 1 of a uniform total stress sigma ([Dim*Dim], row a = force direction, as P1) with no
 // stabilization, for the consistent surface load of a traction (include/mupm/kernels/
 // boundary_conditions.hpp, consistent_traction_load): P1 = sigma K^-1 on the points that carry
-// energy (0 on slaved layer points and where K is singular), P2 = eps = kappa = 0, w0 = 0. Pass 2
+// energy (0 on slaved layer points and where K is singular), P2 = eps = kappa = 0, winv = 0. Pass 2
 // then gives the force and moment densities the discrete operator makes of that stress,
 //   f_i = sigma sum_j (K_i^-1 + K_j^-1) xi V_j,   l_i = 1/2 sum_j xi x (T_ij - T_ji) V_j
 // (eqs 105-112 with T = sigma K^-1 xi): zero where families are whole and K is the bulk's, the
@@ -458,7 +491,7 @@ void uniform_stress_pass1(const Points<Dim>& pts, const ShapeTensors<Dim>& shape
   auto fixed = pts.fixed;
   auto Kinv_v = shape.Kinv;
   auto sing = shape.singular;
-  auto eps_v = st.eps, kap_v = st.kappa, P1 = st.P1, P2 = st.P2, w0_v = st.w0;
+  auto eps_v = st.eps, kap_v = st.kappa, P1 = st.P1, P2 = st.P2, winv = st.winv;
   auto degen = st.degenerate;
   Kokkos::parallel_for(
       "mupm::Solid::uniform_stress_pass1", range(0, pts.n_owned),
@@ -476,7 +509,7 @@ void uniform_stress_pass1(const Points<Dim>& pts, const ShapeTensors<Dim>& shape
         }
         for (int k = 0; k < R * Dim; ++k)
           kap_v(i, k) = P2(i, k) = 0;
-        w0_v(i) = 0;
+        winv(i) = 0;
         degen(i) = 0;
       });
 }

@@ -9,6 +9,7 @@
 #include <Tpetra_Import.hpp>
 #include <Tpetra_Map.hpp>
 #include <Tpetra_MultiVector.hpp>
+#include <map>
 #include <vector>
 
 #include "mupm/core/types.hpp"
@@ -51,8 +52,14 @@ class Distribution {
   Teuchos::RCP<const Import> importer_;
   std::size_t n_owned_ = 0, n_ghost_ = 0, refresh_count_ = 0;
   // Buffers kept between calls of the same width to avoid re-allocation every step.
-  Teuchos::RCP<MultiVector> owned_buf_, overlap_buf_;
-  Teuchos::RCP<MultiVector> sum_owned_, sum_overlap_;  // add_to_owners
+  // Pairs of (owned, overlap) buffers by width, kept for the run: a step refreshes fields of a
+  // few widths in turn, and a buffer made anew for each would be allocated (and Tpetra's
+  // communication buffers with it) several times a step.
+  struct Buffers {
+    Teuchos::RCP<MultiVector> owned, overlap;
+  };
+  Buffers& buffers(std::map<std::size_t, Buffers>& kept, std::size_t width) const;
+  std::map<std::size_t, Buffers> refresh_bufs_, sum_bufs_;  // refresh, add_to_owners
 };
 
 }  // namespace mupm

@@ -170,6 +170,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -252,7 +253,9 @@ class PressureProjection {
       solver_.refresh();
     }
     const auto& owned = disc_.dist.owned_map();
-    TpetraVector du(dofs_), bp(owned), b(joint_), c(joint_), ac(joint_), x(joint_), y(joint_);
+    TpetraVector &du = work(kDu, dofs_), &bp = work(kBp, owned), &b = work(kB, joint_),
+                 &c = work(kC, joint_), &ac = work(kAc, joint_), &x = work(kX, joint_),
+                 &y = work(kY, joint_);
     {
       auto v = du.getLocalViewHost(Tpetra::Access::OverwriteAll);
       for (std::size_t i = 0; i < n; ++i) {
@@ -271,8 +274,8 @@ class PressureProjection {
       for (std::size_t k = 0; k < m; ++k)
         cv(n + k, 0) = crack.held[k] ? crack.start[k] : 0.0;
     }
-    static_.matrix()->apply(c, ac);  // A c = (static part + the network's rows) c
-    TpetraVector e(joint_);          // the unfelt p_f^n (CrackBlock): the correction applies it too
+    static_.matrix()->apply(c, ac);      // A c = (static part + the network's rows) c
+    TpetraVector& e = work(kE, joint_);  // the unfelt p_f^n (CrackBlock): the correction applies it
     if (any_crack_) {
       network->apply(c, ac, Teuchos::NO_TRANS, 1.0, 1.0);
       {
@@ -283,7 +286,7 @@ class PressureProjection {
           ev(n + k, 0) = crack.unfelt[k];
       }
       // ... and the volume change it gives the skeleton within the step: dt^2 B M^-1 B^T e.
-      TpetraVector fe(dofs_), be(joint_);
+      TpetraVector &fe = work(kFe, dofs_), &be = work(kBe, joint_);
       coupling_s_->apply(e, fe, Teuchos::TRANS);
       fe.elementWiseMultiply(1.0, *inverse_mass_, fe, 0.0);
       coupling_s_->apply(fe, be);
@@ -322,7 +325,8 @@ class PressureProjection {
     r.finite_rhs = res.finite_rhs;
     s_h_.matrix()->apply(x, y);  // the increments: S_H x + c
     y.update(1.0, c, 1.0);
-    TpetraVector yp(joint_), f(dofs_);  // the skeleton's correction: S_P x + c
+    TpetraVector &yp = work(kYp, joint_), &f = work(kF, dofs_);  // the skeleton's correction:
+                                                                 // S_P x + c
     s_p_.matrix()->apply(x, yp);
     yp.update(1.0, c, 1.0, e, 1.0);
     coupling_s_->apply(yp, f, Teuchos::TRANS);
@@ -361,7 +365,7 @@ class PressureProjection {
   // increment, for the water bookkeeping).
   void flow_increment(const Scalars& dp, const Scalars& out) const {
     const auto& owned = disc_.dist.owned_map();
-    TpetraVector x(owned), y(owned);
+    TpetraVector &x = work(kFlowX, owned), &y = work(kFlowY, owned);
     {
       auto v = x.getLocalViewHost(Tpetra::Access::OverwriteAll);
       for (std::size_t i = 0; i < disc_.points.n_owned; ++i)
@@ -705,6 +709,16 @@ class PressureProjection {
   MPI_Comm comm_;
   GlobalId offset_ = 0;
   Teuchos::RCP<const Map> dofs_, joint_;
+  // The work vectors of step() and flow_increment(), kept while their maps are: a step
+  // allocates none (each one written in full, or the output of an apply, before it is read).
+  enum Work { kDu, kBp, kB, kC, kAc, kX, kY, kE, kFe, kBe, kYp, kF, kFlowX, kFlowY, kWorks };
+  mutable std::array<Teuchos::RCP<TpetraVector>, kWorks> work_;
+  TpetraVector& work(Work w, const Teuchos::RCP<const Map>& map) const {
+    auto& v = work_[w];
+    if (v.is_null() || v->getMap().get() != map.get())
+      v = Teuchos::rcp(new TpetraVector(map));
+    return *v;
+  }
   // flow_, coupling_: over the points; the others over the joint map (static_: the system's
   // rows but the network's of the step, before R and S; composed_: after them).
   FlowOperator<Dim> flow_;
