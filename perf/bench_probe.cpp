@@ -1,0 +1,124 @@
+// What one core of this machine can do, to place the kernels against (perf/README.md, "The
+// limit"): the floating-point throughput of the instructions mupm's kernels compile to, of the
+// vector FMAs the core has, and the memory bandwidth of a stream.
+//
+// - BM_ScalarMulAdd: a*x + y on scalars in 16 independent chains, one scalar mul and add each
+//   (vectorization off): what a kernel whose bond loop the compiler does not vectorize can reach
+//   in the generic x86-64 build mupm makes (SSE2, no FMA instruction). 2 flops an element.
+// - BM_Sse2MulAdd: the same, vectorized by the compiler to SSE2 (2 doubles a register).
+// - BM_VectorFma: the same on arrays the compiler vectorizes, with the core's widest FMA
+//   (target attribute: AVX-512F where the core has it, else AVX2 + FMA; both chosen at run time).
+// - BM_StreamTriad: a = b + s c over arrays of 3 x 64 MiB, OpenMP threads (24 bytes an element
+//   moved by the program, 32 with the write-allocate of a).
+// Wall clock; flops_per_s and bytes_per_s are the counters to read.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <cstddef>
+#include <vector>
+
+namespace {
+
+constexpr int kChains = 16;  // independent accumulators: enough to cover the add latency
+constexpr long kRounds = 1 << 20;
+
+__attribute__((noinline, optimize("no-tree-vectorize"))) void scalar_rounds(double* acc,
+                                                                             long rounds) {
+  const double a = 0.999999, x = 1e-9;
+  for (long r = 0; r < rounds; ++r)
+    for (int c = 0; c < kChains; ++c)
+      acc[c] = a * acc[c] + x;
+}
+__attribute__((noinline)) void sse2_rounds(double* acc, long rounds) {
+  const double a = 0.999999, x = 1e-9;
+  for (long r = 0; r < rounds; ++r)
+    for (int c = 0; c < kChains; ++c)
+      acc[c] = a * acc[c] + x;
+}
+
+template <void (*Rounds)(double*, long)>
+void BM_MulAdd(benchmark::State& state) {
+  alignas(64) double acc[kChains];
+  for (int c = 0; c < kChains; ++c)
+    acc[c] = 1.0 + 1e-3 * c;
+  for (auto _ : state) {
+    Rounds(acc, kRounds);
+    benchmark::DoNotOptimize(acc);
+  }
+  state.counters["flops_per_s"] = benchmark::Counter(2.0 * kChains * double(kRounds),
+                                                     benchmark::Counter::kIsIterationInvariantRate);
+}
+void BM_ScalarMulAdd(benchmark::State& state) {
+  BM_MulAdd<scalar_rounds>(state);
+}
+void BM_Sse2MulAdd(benchmark::State& state) {
+  BM_MulAdd<sse2_rounds>(state);
+}
+
+// 8 chains of 8 doubles: 64 accumulators, one AVX-512 register each or two AVX2 registers.
+template <int Width>
+void vector_rounds(double* acc, long rounds) {
+  const double a = 0.999999, x = 1e-9;
+  for (long r = 0; r < rounds; ++r)
+#pragma GCC ivdep
+    for (int c = 0; c < Width; ++c)
+      acc[c] = a * acc[c] + x;
+}
+__attribute__((target("avx512f,fma"))) void rounds_avx512(double* acc, long rounds) {
+  vector_rounds<64>(acc, rounds);
+}
+__attribute__((target("avx2,fma"))) void rounds_avx2(double* acc, long rounds) {
+  vector_rounds<64>(acc, rounds);
+}
+
+void BM_VectorFma(benchmark::State& state) {
+  alignas(64) double acc[64];
+  for (int c = 0; c < 64; ++c)
+    acc[c] = 1.0 + 1e-3 * c;
+  __builtin_cpu_init();
+  const bool avx512 = __builtin_cpu_supports("avx512f");
+  if (!avx512 && !__builtin_cpu_supports("avx2")) {
+    state.SkipWithError("no AVX2 on this core");
+    return;
+  }
+  for (auto _ : state) {
+    if (avx512)
+      rounds_avx512(acc, kRounds);
+    else
+      rounds_avx2(acc, kRounds);
+    benchmark::DoNotOptimize(acc);
+  }
+  state.SetLabel(avx512 ? "AVX-512 FMA" : "AVX2 FMA");
+  state.counters["flops_per_s"] =
+      benchmark::Counter(2.0 * 64 * double(kRounds), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_StreamTriad(benchmark::State& state) {
+  const std::size_t n = std::size_t(64) << 17;  // 8 M doubles = 64 MiB an array
+  const int threads = int(state.range(0));
+  std::vector<double> a(n), b(n), c(n);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {  // first touch by the threads that use the pages
+    a[i] = 0;
+    b[i] = 1;
+    c[i] = 2;
+  }
+  const double s = 0.5;
+  for (auto _ : state) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::size_t i = 0; i < n; ++i)
+      a[i] = b[i] + s * c[i];
+    benchmark::DoNotOptimize(a.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["bytes_per_s"] =
+      benchmark::Counter(24.0 * double(n), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+}  // namespace
+
+BENCHMARK(BM_ScalarMulAdd)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Sse2MulAdd)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VectorFma)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StreamTriad)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
