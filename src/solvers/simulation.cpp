@@ -308,6 +308,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
     settings.damping = model.damping;
     settings.fracture = model.fracture;
     settings.semi_implicit = model.run.semi_implicit;
+    settings.fluid = has_fluid(physics);
     const auto& f = model.run.fields;
     if (model.constitutive_model == ConstitutiveModel::MicropolarDruckerPrager ||
         std::find(f.begin(), f.end(), "second_order_work") != f.end())

@@ -80,6 +80,9 @@ struct SolidSettings {
   // Solver->Pressure Integration = Semi-Implicit: the pore pressure's correction of each step
   // is booked (add_projection_work) and reported.
   bool semi_implicit = false;
+  // A fluid module is coupled: pore pressures may arise even where none is set at the start
+  // (with Semi-Implicit the undrained modulus is zero, so the points' state cannot tell).
+  bool fluid = false;
 };
 
 // Law: the pointwise constitutive law of pass 1 (include/mupm/kernels/solid.hpp), chosen once
@@ -297,10 +300,11 @@ class SolidSolver : public Mechanics, public Skeleton {
     if (mirrored_ || slaved_)
       mark_mirrored_layers(bcs_, p, disc_.mirror);
     update_density();
-    // Pore water pressure, for the whole run: a fluid (undrained modulus set from the start), or
-    // a held initial pressure (without a fluid p never changes). The effective force state's
-    // bond energy then needs the pore-water part of P1 apart.
-    pressure_ = (breaks() || keep_pore_part_) && has_pressure();
+    // Pore water pressure, for the whole run: a fluid, or a held initial pressure (without a
+    // fluid p never changes). The effective force state's bond energy then needs the pore-water
+    // part of P1 apart. The same choice in a straight run and in its restart (which finds the
+    // pressures the run developed: with Semi-Implicit a fluid run may start with none).
+    pressure_ = (breaks() || keep_pore_part_) && (set_.fluid || has_pressure());
     if (pressure_ && set_.fracture.effective_state && st_.P1w.extent(0) == 0)
       st_.P1w = Vectors("mupm::pore_part_of_P1", p.size(), Dim * Dim);
     if (!restarted) {
