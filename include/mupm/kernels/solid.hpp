@@ -38,6 +38,7 @@
 #define MUPM_SOLID_HPP
 
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "mupm/core/small_matrix.hpp"
@@ -341,9 +342,21 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
 // text says effective): with st.P1w allocated, the effective state, the pore-water part
 // -(S_r p* K^-1 xi) of each end taken out: the skeleton's bonds break by the skeleton's stress
 // (Terzaghi). Without it (no fluid, or Fracture->Bond Energy Force State = Total) the total.
-template <int Dim>
-void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& prm,
-                 SolidState<Dim>& st) {
+//
+// The variant (eq 17's water force, recording or accumulating the bond energy, the effective
+// force state) is fixed for a run: solid_pass2 picks an instantiation of solid_pass2_variant, whose
+// bond loop tests none of them (so that a device backend compiles each as a kernel of its own).
+template <bool Eq17, BondWork Work, bool Effective>
+struct Pass2Variant {
+  static constexpr bool eq17 = Eq17;
+  static constexpr bool record = Work != BondWork::Off;
+  static constexpr bool accumulate = Work == BondWork::Accumulate;
+  static constexpr bool effective = Effective && record;
+};
+
+template <int Dim, class V>
+void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& prm,
+                         SolidState<Dim>& st) {
   constexpr int R = kRotDim<Dim>;
   auto offsets = bonds.offsets;
   auto neighbor = bonds.neighbor;
@@ -356,13 +369,9 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
   auto inc = st.increment, P1w = st.P1w, wmax = st.max_energy;
   auto P1f = st.P1f, srf = pts.pf_saturation;
   auto fw = st.water_force;
-  const bool eq17 = P1f.extent(0) > 0;
   auto force = st.force, moment = st.moment;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
   const double c2 = prm.stabilization * prm.stab_modulus;
-  const bool record = st.work != BondWork::Off && bonds.pair_width == Dim + R;
-  const bool accumulate = record && st.work == BondWork::Accumulate;
-  const bool effective = P1w.extent(0) > 0;
   Kokkos::parallel_for(
       "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         double f[Dim] = {}, l[R] = {}, wm = 0, f17[Dim + R] = {};
@@ -390,22 +399,23 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
           //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
           double t[Dim], m[R], cf[Dim] = {};
-          if (eq17 && srf(i) > 0 && srf(j) > 0) {  // eq 17: the fracture bond's water is p_f's
-            for (int a = 0; a < Dim; ++a) {
-              double ci = 0, cj = 0;
-              for (int k = 0; k < Dim; ++k) {
-                ci += P1f(i, a * Dim + k) * xi[k];
-                cj += P1f(j, a * Dim + k) * xi[k];
+          if constexpr (V::eq17)
+            if (srf(i) > 0 && srf(j) > 0) {  // eq 17: the fracture bond's water is p_f's
+              for (int a = 0; a < Dim; ++a) {
+                double ci = 0, cj = 0;
+                for (int k = 0; k < Dim; ++k) {
+                  ci += P1f(i, a * Dim + k) * xi[k];
+                  cj += P1f(j, a * Dim + k) * xi[k];
+                }
+                cf[a] = ci + cj;
               }
-              cf[a] = ci + cj;
+              double xc[R];
+              cross<Dim>(xi, cf, xc);
+              for (int a = 0; a < Dim; ++a)
+                f17[a] += cf[a] * vj;
+              for (int r = 0; r < R; ++r)
+                f17[Dim + r] += 0.5 * xc[r] * vj;
             }
-            double xc[R];
-            cross<Dim>(xi, cf, xc);
-            for (int a = 0; a < Dim; ++a)
-              f17[a] += cf[a] * vj;
-            for (int r = 0; r < R; ++r)
-              f17[Dim + r] += 0.5 * xc[r] * vj;
-          }
           for (int a = 0; a < Dim; ++a) {
             double pi = 0, pj = 0, ei = 0, ej = 0;
             for (int k = 0; k < Dim; ++k) {
@@ -433,8 +443,8 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           cross<Dim>(xi, t, xt);  // 1/2 xi x (T_ij - T_ji)
           for (int r = 0; r < R; ++r)
             l[r] += 0.5 * xt[r] * vj;
-          if (record) {
-            if (effective)  // take out -(S_r p* K^-1 xi) of both ends (header)
+          if constexpr (V::record) {
+            if constexpr (V::effective)  // take out -(S_r p* K^-1 xi) of both ends (header)
               for (int a = 0; a < Dim; ++a) {
                 double wi = 0, wj = 0;
                 for (int k = 0; k < Dim; ++k) {
@@ -443,7 +453,7 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
                 }
                 t[a] += (wi + wj) - cf[a];  // the bond's water part, whichever pressure
               }
-            if (accumulate) {
+            if constexpr (V::accumulate) {
               // dU^ = d(u_j - u_i) - (d theta_i + d theta_j)/2 x xi, dOmega = d theta_j - d
               // theta_i.
               double tb[R], c[Dim], dw = 0;
@@ -467,12 +477,38 @@ void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& 
           force(i, d) = f[d];
         for (int r = 0; r < R; ++r)
           moment(i, r) = l[r];
-        if (accumulate)
+        if constexpr (V::accumulate)
           wmax(i) = wm;
-        if (eq17)
+        if constexpr (V::eq17)
           for (int c = 0; c < Dim + R; ++c)
             fw(i, c) = f17[c];
       });
+}
+
+template <int Dim>
+void solid_pass2(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& prm,
+                 SolidState<Dim>& st) {
+  constexpr int R = kRotDim<Dim>;
+  const bool eq17 = st.P1f.extent(0) > 0, effective = st.P1w.extent(0) > 0;
+  const BondWork work = bonds.pair_width == Dim + R ? st.work : BondWork::Off;
+  auto run = [&](auto eq17_tag, auto work_tag, auto effective_tag) {
+    solid_pass2_variant<Dim, Pass2Variant<decltype(eq17_tag)::value, decltype(work_tag)::value,
+                                          decltype(effective_tag)::value>>(pts, bonds, prm, st);
+  };
+  auto with_work = [&](auto eq17_tag) {
+    using T = std::true_type;
+    using F = std::false_type;
+    using Off = std::integral_constant<BondWork, BondWork::Off>;
+    using Rec = std::integral_constant<BondWork, BondWork::Record>;
+    using Acc = std::integral_constant<BondWork, BondWork::Accumulate>;
+    if (work == BondWork::Off)
+      run(eq17_tag, Off{}, F{});
+    else if (work == BondWork::Record)
+      effective ? run(eq17_tag, Rec{}, T{}) : run(eq17_tag, Rec{}, F{});
+    else
+      effective ? run(eq17_tag, Acc{}, T{}) : run(eq17_tag, Acc{}, F{});
+  };
+  eq17 ? with_work(std::true_type{}) : with_work(std::false_type{});
 }
 
 // Pass 1 of a uniform total stress sigma ([Dim*Dim], row a = force direction, as P1) with no
