@@ -149,29 +149,41 @@ class JIntegral : public Module {
         for (int k = 0; k < 3 * nc; ++k)
           mine.push_back(h(i, k));
       }
-      int size = 0, n = int(mine.size());
+      // Rank 0 sums the rows in global-id order (the same bits on any number of ranks) and
+      // sends the sums: no rank but 0 receives more than the 2 nc sums.
+      int size = 0, rank = 0, n = int(mine.size());
       MPI_Comm_size(comm_, &size);
-      std::vector<int> counts(static_cast<std::size_t>(size)), displs(counts.size(), 0);
-      MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-      for (int r = 1; r < size; ++r)
-        displs[std::size_t(r)] = displs[std::size_t(r - 1)] + counts[std::size_t(r - 1)];
-      std::vector<double> all(std::size_t(displs.back() + counts.back()));
-      MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
-                     MPI_DOUBLE, comm_);
-      std::vector<std::size_t> rows(all.size() / std::size_t(w));
-      for (std::size_t r = 0; r < rows.size(); ++r)
-        rows[r] = r;
-      std::sort(rows.begin(), rows.end(), [&](std::size_t a, std::size_t b) {
-        return all[a * std::size_t(w)] < all[b * std::size_t(w)];
-      });
-      for (std::size_t r : rows)
-        for (int c = 0; c < nc; ++c) {
-          const double* t = &all[r * std::size_t(w) + 1 + 3 * std::size_t(c)];
-          out[std::size_t(c)].translational += t[0] + t[1];
-          out[std::size_t(c)].rotational += t[2];
-        }
-      for (auto& v : out)
-        v.total = v.translational + v.rotational;
+      MPI_Comm_rank(comm_, &rank);
+      std::vector<int> counts(rank == 0 ? std::size_t(size) : 0), displs(counts.size(), 0);
+      MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
+      std::vector<double> all, sums(2 * std::size_t(nc), 0.0);
+      if (rank == 0) {
+        for (int r = 1; r < size; ++r)
+          displs[std::size_t(r)] = displs[std::size_t(r - 1)] + counts[std::size_t(r - 1)];
+        all.resize(std::size_t(displs.back() + counts.back()));
+      }
+      MPI_Gatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
+                  0, comm_);
+      if (rank == 0) {
+        std::vector<std::size_t> rows(all.size() / std::size_t(w));
+        for (std::size_t r = 0; r < rows.size(); ++r)
+          rows[r] = r;
+        std::sort(rows.begin(), rows.end(), [&](std::size_t a, std::size_t b) {
+          return all[a * std::size_t(w)] < all[b * std::size_t(w)];
+        });
+        for (std::size_t r : rows)
+          for (std::size_t c = 0; c < std::size_t(nc); ++c) {
+            const double* t = &all[r * std::size_t(w) + 1 + 3 * c];
+            sums[2 * c] += t[0] + t[1];
+            sums[2 * c + 1] += t[2];
+          }
+      }
+      MPI_Bcast(sums.data(), 2 * nc, MPI_DOUBLE, 0, comm_);
+      for (std::size_t c = 0; c < std::size_t(nc); ++c) {
+        out[c].translational = sums[2 * c];
+        out[c].rotational = sums[2 * c + 1];
+        out[c].total = out[c].translational + out[c].rotational;
+      }
     }
     return out;
   }
