@@ -50,53 +50,17 @@ crack() {  # crack FOLDER DROP_TOLERANCE REFRESH_INTERVAL
     -e 's|<Parameter name="End Time" type="double" value="[^"]*"/>|<Parameter name="Number of Steps" type="int" value="150"/>|' \
     "${shared[@]}" "$SRC/inputs/example1_fluid_driven.xml"
 }
+source "$SRC/perf/cube_input.sh"
 cube() {  # cube FOLDER N HORIZON STEPS
-  local fix="" comp
+  local bcs="" comp
   for comp in x y z; do
-    fix+="<ParameterList name=\"base $comp\"><Parameter name=\"Type\" type=\"string\" value=\"Displacement\"/><Parameter name=\"Region\" type=\"string\" value=\"Layer -z\"/><Parameter name=\"Component\" type=\"string\" value=\"$comp\"/></ParameterList>"
+    bcs+="<ParameterList name=\"base $comp\"><Parameter name=\"Type\" type=\"string\" value=\"Displacement\"/><Parameter name=\"Region\" type=\"string\" value=\"Layer -z\"/><Parameter name=\"Component\" type=\"string\" value=\"$comp\"/></ParameterList>"
   done
-  cat <<XML
-<ParameterList name="mupm">
-  <ParameterList name="Discretization">
-    <Parameter name="Dimension" type="int" value="3"/>
-    <Parameter name="Spacing" type="double" value="0.01"/>
-    <Parameter name="Counts" type="Array(int)" value="{$2, $2, $2}"/>
-    <Parameter name="Horizon Factor" type="double" value="$3"/>
-    <Parameter name="Boundary Layers" type="Array(string)" value="{-z, +z}"/>
-  </ParameterList>
-  <ParameterList name="Materials">
-    <Parameter name="Bulk Modulus" type="double" value="10e6"/>
-    <Parameter name="Shear Modulus" type="double" value="6e6"/>
-    <Parameter name="Micropolar Shear Modulus" type="double" value="3e6"/>
-    <Parameter name="Length Scale" type="double" value="0.01"/>
-    <Parameter name="Solid Density" type="double" value="2000"/>
-    <Parameter name="Porosity" type="double" value="0.3"/>
-  </ParameterList>
-  <ParameterList name="Fluid">
-    <Parameter name="Water Density" type="double" value="1000"/>
-    <Parameter name="Fluid Bulk Modulus" type="double" value="2.2e9"/>
-    <Parameter name="Incompressible" type="bool" value="true"/>
-    <Parameter name="Hydraulic Conductivity" type="double" value="5.11e-5"/>
-  </ParameterList>
-  <ParameterList name="Boundary Conditions">
-    $fix
-    <ParameterList name="drain"><Parameter name="Type" type="string" value="Pore Pressure"/><Parameter name="Region" type="string" value="Layer +z"/></ParameterList>
-    <ParameterList name="press"><Parameter name="Type" type="string" value="Velocity"/><Parameter name="Region" type="string" value="Layer +z"/><Parameter name="Component" type="string" value="z"/><Parameter name="Value" type="double" value="-0.01"/></ParameterList>
-  </ParameterList>
-  <ParameterList name="Solver">
-    <Parameter name="Physics" type="string" value="Hydro-Mechanical"/>
-    <Parameter name="Automatic Time Step" type="bool" value="true"/>
-    <Parameter name="Pressure Integration" type="string" value="Semi-Implicit"/>
-    <Parameter name="Number of Steps" type="int" value="$4"/>
-  </ParameterList>
-  <ParameterList name="Output">
-    <Parameter name="Folder" type="string" value="$1"/>
-    <Parameter name="Field Interval" type="int" value="0"/>
-    <Parameter name="Checkpoint Interval" type="int" value="0"/>
-    <Parameter name="Time Series Interval" type="int" value="1"/>
-  </ParameterList>
-</ParameterList>
-XML
+  bcs+='<ParameterList name="drain"><Parameter name="Type" type="string" value="Pore Pressure"/><Parameter name="Region" type="string" value="Layer +z"/></ParameterList>'
+  bcs+='<ParameterList name="press"><Parameter name="Type" type="string" value="Velocity"/><Parameter name="Region" type="string" value="Layer +z"/><Parameter name="Component" type="string" value="z"/><Parameter name="Value" type="double" value="-0.01"/></ParameterList>'
+  cube_input "$1" "$2" 0.01 "$3" "$4" Hydro-Mechanical "$bcs" \
+    '<Parameter name="Automatic Time Step" type="bool" value="true"/><Parameter name="Pressure Integration" type="string" value="Semi-Implicit"/>' \
+    '<Parameter name="Water Density" type="double" value="1000"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e9"/><Parameter name="Incompressible" type="bool" value="true"/><Parameter name="Hydraulic Conductivity" type="double" value="5.11e-5"/>'
 }
 
 # it/step: Krylov iterations (CG, or GMRES with mirrored pressure layers); solve ms: the
