@@ -23,7 +23,7 @@ constexpr int kChains = 16;  // independent accumulators: enough to cover the ad
 constexpr long kRounds = 1 << 20;
 
 __attribute__((noinline, optimize("no-tree-vectorize"))) void scalar_rounds(double* acc,
-                                                                             long rounds) {
+                                                                            long rounds) {
   const double a = 0.999999, x = 1e-9;
   for (long r = 0; r < rounds; ++r)
     for (int c = 0; c < kChains; ++c)
@@ -55,6 +55,7 @@ void BM_Sse2MulAdd(benchmark::State& state) {
   BM_MulAdd<sse2_rounds>(state);
 }
 
+#if defined(__x86_64__)
 // 8 chains of 8 doubles: 64 accumulators, one AVX-512 register each or two AVX2 registers.
 template <int Width>
 void vector_rounds(double* acc, long rounds) {
@@ -92,6 +93,7 @@ void BM_VectorFma(benchmark::State& state) {
   state.counters["flops_per_s"] =
       benchmark::Counter(2.0 * 64 * double(kRounds), benchmark::Counter::kIsIterationInvariantRate);
 }
+#endif
 
 void BM_StreamTriad(benchmark::State& state) {
   const std::size_t n = std::size_t(64) << 17;  // 8 M doubles = 64 MiB an array
@@ -119,6 +121,8 @@ void BM_StreamTriad(benchmark::State& state) {
 
 BENCHMARK(BM_ScalarMulAdd)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Sse2MulAdd)->UseRealTime()->Unit(benchmark::kMillisecond);
+#if defined(__x86_64__)
 BENCHMARK(BM_VectorFma)->UseRealTime()->Unit(benchmark::kMillisecond);
+#endif
 BENCHMARK(BM_StreamTriad)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();
