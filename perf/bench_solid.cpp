@@ -38,7 +38,7 @@ struct Body {
     st.allocate(disc.points.size(), disc.points.n_owned);
     set_field();
     // Pass 2 reads pass 1's outputs: run the whole evaluation once so that pass 2 alone sees
-    // real eps, kappa, P1, P2, w0 (and the pages are touched before timing).
+    // real eps, kappa, P1, P2, winv (and the pages are touched before timing).
     solid_forces(disc, prm, st);
     Kokkos::fence();
   }

@@ -86,6 +86,13 @@ void time_loop(bool inside) {
   state().in_loop = inside;
 }
 
+long long loop_allocations() {
+  long long n = 0;
+  for (const auto& a : state().allocs)
+    n += a.second.first;
+  return n;
+}
+
 bool enable() {
   if (std::getenv("KOKKOS_TOOLS_LIBS") || std::getenv("KOKKOS_PROFILE_LIBRARY"))
     return false;

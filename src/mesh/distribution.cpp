@@ -17,7 +17,7 @@ Distribution::Distribution(const Teuchos::RCP<const Comm>& comm, const std::vect
 }
 
 Distribution::Buffers& Distribution::buffers(std::map<std::size_t, Buffers>& kept,
-                                             std::size_t width) const {
+                                             std::size_t width) {
   Buffers& b = kept[width];
   if (b.owned.is_null()) {
     b.owned = Teuchos::rcp(new MultiVector(owned_map_, width, false));

@@ -27,6 +27,8 @@ void reset();
 // Marks the time loop: View allocations between time_loop(true) and time_loop(false) are
 // counted by label and reported.
 void time_loop(bool inside);
+// This rank's View allocations counted since enable() or reset() (time_loop).
+long long loop_allocations();
 std::vector<Entry> local_entries();
 
 // Collective: prints, on rank 0 of comm, one line per label of rank 0 with calls and the min and

@@ -81,7 +81,7 @@ struct JContours {
 
 // Per owned point i and contour c: out(i, 3c + 0) the W term, 3c + 1 the u terms, 3c + 2 the
 // theta terms (each already signed as it enters J, per unit thickness). u, theta, eps, kappa,
-// P1, P2, w0 (and P1w when allocated) current on the ghosts, as solid pass 2 leaves them.
+// P1, P2, winv (and P1w when allocated) current on the ghosts, as solid pass 2 leaves them.
 inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const SolidParams& prm,
                              const SolidState<2>& st, const JContours& jc, const Vectors& out) {
   constexpr int Dim = 2, R = 1;

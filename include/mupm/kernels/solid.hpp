@@ -202,7 +202,10 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
         //   s1 = sum g1 |U^|^2 V, s2 = sum g2 |Omega|^2 V.
         // Then Q1 = sum alpha1 (U^ - eps xi) (x) xi V = (Ag - eps Mg1)/w0, Q2 likewise, and
         // sum alpha1 |U^ - eps xi|^2 V = (s1 - 2 eps:Ag + sum_a eps_a.Mg1.eps_a)/w0: the same
-        // sums as a second loop over the residuals, without visiting the family twice.
+        // sums as a second loop over the residuals, without visiting the family twice (g1, g2
+        // below include V_j). The energy is now a difference of sums that nearly cancel where
+        // the field is nearly affine: its round-off is that of s1, and a point's stabilization
+        // energy may come out a few ulps of s1 below zero (energies only; the forces take Q).
         constexpr int NS = Dim * (Dim + 1) / 2;  // Mg: symmetric, upper triangle by rows
         double A[Dim * Dim] = {}, B[R * Dim] = {}, Ag[Dim * Dim] = {}, Bg[R * Dim] = {};
         double Mg1[NS] = {}, Mg2[NS] = {}, s1 = 0, s2 = 0;
@@ -376,16 +379,16 @@ void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const Solid
       "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         double f[Dim] = {}, l[R] = {}, wm = 0, f17[Dim + R] = {};
         // The owned point's rows, read once (the bond loop's stores could alias them).
-        double P1i[Dim * Dim], ei_[Dim * Dim], P2i[R * Dim], ki_[R * Dim];
+        double P1i[Dim * Dim], Ei[Dim * Dim], P2i[R * Dim], Ki[R * Dim];
         for (int k = 0; k < Dim * Dim; ++k) {
           P1i[k] = P1(i, k);
-          ei_[k] = eps(i, k);
+          Ei[k] = eps(i, k);
         }
         for (int k = 0; k < R * Dim; ++k) {
           P2i[k] = P2(i, k);
-          ki_[k] = kap(i, k);
+          Ki[k] = kap(i, k);
         }
-        const double wi_ = winv(i);
+        const double winv_i = winv(i);
         for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
           if (!intact(b))
             continue;
@@ -395,7 +398,7 @@ void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const Solid
           const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, Uh, Om);
           const double il = 1.0 / std::sqrt(len2);
           const double a1 = c1 * (il * il * il), a2 = c2 * il;  // eqs 66-70 with w0 = 1
-          const double a1i = a1 * wi_, a2i = a2 * wi_, a1j = a1 * winv(j), a2j = a2 * winv(j);
+          const double a1i = a1 * winv_i, a2i = a2 * winv_i, a1j = a1 * winv(j), a2j = a2 * winv(j);
           // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
           //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
           double t[Dim], m[R], cf[Dim] = {};
@@ -421,7 +424,7 @@ void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const Solid
             for (int k = 0; k < Dim; ++k) {
               pi += P1i[a * Dim + k] * xi[k];
               pj += P1(j, a * Dim + k) * xi[k];
-              ei += ei_[a * Dim + k] * xi[k];
+              ei += Ei[a * Dim + k] * xi[k];
               ej += eps(j, a * Dim + k) * xi[k];
             }
             t[a] = ((pi + pj) + (a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej))) + cf[a];
@@ -433,7 +436,7 @@ void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const Solid
             for (int k = 0; k < Dim; ++k) {
               pi += P2i[r * Dim + k] * xi[k];
               pj += P2(j, r * Dim + k) * xi[k];
-              ki += ki_[r * Dim + k] * xi[k];
+              ki += Ki[r * Dim + k] * xi[k];
               kj += kap(j, r * Dim + k) * xi[k];
             }
             m[r] = (pi + pj) + (a2i * (Om[r] - ki) + a2j * (Om[r] - kj));

@@ -58,7 +58,7 @@ class Distribution {
   struct Buffers {
     Teuchos::RCP<MultiVector> owned, overlap;
   };
-  Buffers& buffers(std::map<std::size_t, Buffers>& kept, std::size_t width) const;
+  Buffers& buffers(std::map<std::size_t, Buffers>& kept, std::size_t width);
   std::map<std::size_t, Buffers> refresh_bufs_, sum_bufs_;  // refresh, add_to_owners
 };
 

@@ -330,7 +330,7 @@ class PressureProjection {
     s_p_.matrix()->apply(x, yp);
     yp.update(1.0, c, 1.0, e, 1.0);
     coupling_s_->apply(yp, f, Teuchos::TRANS);
-    double work = 0;
+    double correction_work = 0;
     {
       auto yv = y.getLocalViewHost(Tpetra::Access::ReadOnly);
       auto fv = f.getLocalViewHost(Tpetra::Access::ReadOnly);
@@ -352,12 +352,12 @@ class PressureProjection {
           const double before = dt * (vel - dt * acc);
           pos += dt * dt * a;
           vel += dt * a;
-          work += 0.5 * fv(q, 0) * (pos - sk.start(i, k) + before);
+          correction_work += 0.5 * fv(q, 0) * (pos - sk.start(i, k) + before);
         }
       }
     }
-    MPI_Allreduce(MPI_IN_PLACE, &work, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    r.work = work;
+    MPI_Allreduce(MPI_IN_PLACE, &correction_work, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    r.work = correction_work;
     return r;
   }
 
