@@ -170,9 +170,7 @@ void report(MPI_Comm comm, std::ostream& out) {
   const int n = static_cast<int>(rows.size());
   MPI_Reduce(t.data(), tmin.data(), n, MPI_DOUBLE, MPI_MIN, 0, comm);
   MPI_Reduce(t.data(), tmax.data(), n, MPI_DOUBLE, MPI_MAX, 0, comm);
-  long long allocs = 0, max_allocs = 0;
-  for (const auto& a : state().allocs)
-    allocs += a.second.first;
+  long long allocs = loop_allocations(), max_allocs = 0;
   MPI_Reduce(&allocs, &max_allocs, 1, MPI_LONG_LONG, MPI_MAX, 0, comm);
   if (rank != 0)
     return;

@@ -51,7 +51,6 @@ class Distribution {
   Teuchos::RCP<const Map> owned_map_, overlap_map_;
   Teuchos::RCP<const Import> importer_;
   std::size_t n_owned_ = 0, n_ghost_ = 0, refresh_count_ = 0;
-  // Buffers kept between calls of the same width to avoid re-allocation every step.
   // Pairs of (owned, overlap) buffers by width, kept for the run: a step refreshes fields of a
   // few widths in turn, and a buffer made anew for each would be allocated (and Tpetra's
   // communication buffers with it) several times a step.
