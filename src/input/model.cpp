@@ -361,6 +361,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
     r.pressure_solve.drop_tolerance = ps.get<double>("Drop Tolerance");
     r.pressure_solve.tolerance = ps.get<double>("Tolerance");
     r.pressure_solve.max_iterations = ps.get<int>("Maximum Iterations");
+    r.pressure_solve.recycle = ps.get<int>("Recycled Vectors");
   }
   r.time_step = solver.get<double>("Time Step");
   r.automatic_time_step = solver.get<bool>("Automatic Time Step");

@@ -1,6 +1,7 @@
 #include "mupm/solvers/linear_solve.hpp"
 
 #include <BelosLinearProblem.hpp>
+#include <BelosRCGSolMgr.hpp>
 #include <BelosSolverFactory.hpp>
 #include <BelosTpetraAdapter.hpp>
 #include <Ifpack2_Factory.hpp>
@@ -93,8 +94,18 @@ struct LinearSolve::Impl {
   Teuchos::RCP<const CrsMatrix> pm;  // the matrix prec was computed from
   Teuchos::RCP<Belos::LinearProblem<double, MV, OP>> problem;
   Teuchos::RCP<Belos::SolverManager<double, MV, OP>> solver;
-  Teuchos::RCP<TpetraVector> x0;  // solve()'s copy of the initial guess, kept while its map is
+  // solve()'s copy of the initial guess and (RCG) its residual, kept while their map is
+  Teuchos::RCP<TpetraVector> x0, r0;
 };
+
+namespace {
+// `kept`, made anew only when `like`'s map is not its own.
+TpetraVector& work(Teuchos::RCP<TpetraVector>& kept, const TpetraVector& like) {
+  if (kept.is_null() || kept->getMap().get() != like.getMap().get())
+    kept = Teuchos::rcp(new TpetraVector(like.getMap(), false));
+  return *kept;
+}
+}  // namespace
 
 LinearSolve::LinearSolve(const LinearSolveSettings& settings)
     : set_(settings), impl_(Teuchos::rcp(new Impl)) {
@@ -110,7 +121,14 @@ LinearSolve::LinearSolve(const LinearSolveSettings& settings)
   params->set("Verbosity", 0);
   // Relative to ||b|| (Belos' default is the initial residual, which a good initial guess
   // makes small and the test then needlessly strict).
-  if (set_.method == "GMRES") {
+  if (set_.recycle < 0)
+    throw std::invalid_argument("LinearSolve: a recycle space of " + std::to_string(set_.recycle) +
+                                " vectors");
+  if (method() == "RCG") {
+    // RCG's convergence test is relative to the initial residual, which solve() computes.
+    params->set("Num Blocks", 25);
+    params->set("Num Recycled Blocks", set_.recycle);
+  } else if (set_.method == "GMRES") {
     params->set("Num Blocks", set_.restart);
     params->set("Maximum Restarts", set_.max_iterations / std::max(1, set_.restart) + 1);
     params->set("Implicit Residual Scaling", std::string("Norm of RHS"));
@@ -123,6 +141,23 @@ LinearSolve::LinearSolve(const LinearSolveSettings& settings)
 
 LinearSolve::~LinearSolve() = default;
 
+std::string LinearSolve::method() const {
+  return set_.method == "CG" && set_.recycle > 0 ? "RCG" : set_.method;
+}
+
+// A Krylov solver without history (RCG: no recycle space) on the current problem. RCG is made
+// directly: Belos' factory does not register it for Tpetra.
+void LinearSolve::new_krylov() {
+  if (method() == "RCG") {
+    impl_->solver = Teuchos::rcp(new Belos::RCGSolMgr<double, MV, OP>());
+    impl_->solver->setParameters(impl_->params);
+  } else {
+    Belos::SolverFactory<double, MV, OP> factory;
+    impl_->solver = factory.create(set_.method, impl_->params);
+  }
+  forget_ = false;
+}
+
 Teuchos::RCP<const CrsMatrix> LinearSolve::preconditioner_matrix() const {
   return impl_->pm;
 }
@@ -132,8 +167,7 @@ void LinearSolve::set_matrix(const Teuchos::RCP<const CrsMatrix>& a) {
   impl_->a = a;
   // A new problem and solver for every matrix: Belos keeps vectors of the last problem's map,
   // and a matrix may come with another map (the fracture network grows).
-  Belos::SolverFactory<double, MV, OP> factory;
-  impl_->solver = factory.create(set_.method, impl_->params);
+  new_krylov();
   impl_->problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>());
   impl_->problem->setOperator(a);
   jacobi_ = set_.preconditioner == "Jacobi";
@@ -244,7 +278,20 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
     r.converged = true;
     return r;
   }
-  const double tol = std::min(0.5, set_.tolerance * scale / bn);
+  // RCG tests ||r|| against the initial residual's norm rn, CG and GMRES against ||b||.
+  double rn = bn;
+  if (method() == "RCG") {
+    TpetraVector& r0 = work(impl_->r0, b);
+    impl_->a->apply(x, r0);
+    r0.update(1.0, b, -1.0);
+    rn = r0.norm2();
+    if (!(rn > set_.tolerance * scale)) {  // x solves it already (rn is finite: b and x are)
+      r.converged = true;
+      r.residual = rn / scale;
+      return r;
+    }
+  }
+  const double tol = std::min(0.5, set_.tolerance * scale / rn);
   impl_->params->set("Convergence Tolerance", tol);
   impl_->solver->setParameters(impl_->params);
   Teuchos::RCP<MV> xv = Teuchos::rcpFromRef(static_cast<MV&>(x));
@@ -261,16 +308,16 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
   // ILU is therefore tried again from the same initial guess: with the ILU of this matrix's
   // values where the factors were of earlier ones (refresh_interval), else with Jacobi, kept
   // for this matrix's values. Otherwise a failed solve, for the caller to report.
-  auto& x0 = impl_->x0;
-  if (x0.is_null() || x0->getMap().get() != x.getMap().get())
-    x0 = Teuchos::rcp(new TpetraVector(x.getMap(), false));
-  x0->assign(x);
+  TpetraVector& x0 = work(impl_->x0, x);
+  x0.assign(x);
+  if (forget_)
+    new_krylov();
   for (;;) {
     impl_->solver->setProblem(impl_->problem);
     try {
       r.converged = impl_->solver->solve() == Belos::Converged;
       r.iterations = impl_->solver->getNumIters();
-      r.residual = impl_->solver->achievedTol() * bn / scale;
+      r.residual = impl_->solver->achievedTol() * rn / scale;
     } catch (const std::exception&) {
       r.converged = false;
       r.iterations = impl_->solver->getNumIters();
@@ -287,7 +334,7 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
       fall_back_to_jacobi();
       precondition();
     }
-    x.assign(*x0);
+    x.assign(x0);
     if (!impl_->problem->setProblem())
       throw std::logic_error("LinearSolve: Belos could not set up the problem");
   }

@@ -546,8 +546,10 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
         << " m^2/(Pa s), K_w = " << f.bulk_modulus
         << " Pa, flow stabilization G = " << f.stabilization
         << ", pressure stabilization G_p = " << f.projection_stabilization
-        << "; one solve per step (" << ph.fluid->pressure_solve_method() << ", "
-        << ls.preconditioner;
+        << "; one solve per step (" << ph.fluid->pressure_solve_method();
+    if (ph.fluid->pressure_solve_method() == "RCG")
+      out << " with " << ls.recycle << " recycled vectors";
+    out << ", " << ls.preconditioner;
     if (ls.preconditioner == "ILU")
       out << "(" << ls.fill_level << ") of the matrix less its entries below " << ls.drop_tolerance
           << " of the diagonals' geometric mean, kept up to " << ls.refresh_interval << " steps";

@@ -71,9 +71,10 @@ PY
 # for 7 steps (Preconditioner Refresh Interval), so the straight run's factors at step 21 are
 # of its step 15 unless the checkpoint it writes at step 20 renews them: the restart, which
 # computes them at step 21, continues it bit for bit only because it does (LinearSolve::renew;
-# without it the accelerations differ).
+# without it the accelerations differ). The solve is the recycling CG (Recycled Vectors = 4),
+# whose space the checkpoint drops likewise (a restart starts without one).
 ff_input() {  # FOLDER STEPS RESTART [CHECKPOINT_INTERVAL]
-  sed -E -e "s|<Parameter name=\"Physics\" type=\"string\" value=\"Hydro-Mechanical\"/>|&<Parameter name=\"Pressure Integration\" type=\"string\" value=\"Semi-Implicit\"/><ParameterList name=\"Pressure Solve\"><Parameter name=\"Preconditioner Refresh Interval\" type=\"int\" value=\"7\"/></ParameterList>|" \
+  sed -E -e "s|<Parameter name=\"Physics\" type=\"string\" value=\"Hydro-Mechanical\"/>|&<Parameter name=\"Pressure Integration\" type=\"string\" value=\"Semi-Implicit\"/><ParameterList name=\"Pressure Solve\"><Parameter name=\"Preconditioner Refresh Interval\" type=\"int\" value=\"7\"/><Parameter name=\"Recycled Vectors\" type=\"int\" value=\"4\"/></ParameterList>|" \
     -e "s|(<Parameter name=\"Fluid Bulk Modulus\"[^>]*>)|\1<Parameter name=\"Incompressible\" type=\"bool\" value=\"true\"/>|" \
     -e "s|<Parameter name=\"End Time\" type=\"double\" value=\"0.5\"/>|<Parameter name=\"Number of Steps\" type=\"int\" value=\"$2\"/><Parameter name=\"Restart From\" type=\"string\" value=\"$3\"/>|" \
     -e "s|<Parameter name=\"Folder\" type=\"string\" value=\"[^\"]*\"/>|<Parameter name=\"Folder\" type=\"string\" value=\"$1\"/>|" \
@@ -87,7 +88,7 @@ ff_input ff_straight 40 "" 20 >ff_straight.xml
 ff_input ff_first 20 "" >ff_first.xml
 ff_input ff_second 40 ff_first/checkpoint.h5 >ff_second.xml
 ff_input ff_threads 40 "" >ff_threads.xml
-for k in 'value="Semi-Implicit"' '"Incompressible"' '"Restart From"' 'Checkpoint Interval" type="int" value="20"' 'Refresh Interval" type="int" value="7"' 'Minimum Aperture" type="double" value="1e-6"'; do
+for k in 'value="Semi-Implicit"' '"Incompressible"' '"Restart From"' 'Checkpoint Interval" type="int" value="20"' 'Refresh Interval" type="int" value="7"' 'Recycled Vectors" type="int" value="4"' 'Minimum Aperture" type="double" value="1e-6"'; do
   grep -q "$k" ff_straight.xml || fail "inputs/example1_fluid_driven_66_explicit.xml changed: ff_straight.xml lacks $k"
 done
 for c in ff_straight ff_first ff_second; do
@@ -95,6 +96,7 @@ for c in ff_straight ff_first ff_second; do
 done
 run 1 2 ff_threads.xml >ff_threads.out 2>&1 || { cat ff_threads.out; fail "ff_threads.xml did not run"; }
 grep -q "drained: the pore pressure is semi-implicit" ff_straight.out || { cat ff_straight.out; fail "not the drained step"; }
+grep -q "one solve per step (RCG with 4 recycled vectors" ff_straight.out || { cat ff_straight.out; fail "not the recycling CG"; }
 "$PYTHON" - <<'PY'
 import csv, h5py, numpy as np
 with h5py.File("ff_straight/checkpoint.h5") as a, h5py.File("ff_second/checkpoint.h5") as b:

@@ -317,7 +317,8 @@ class FluidSolver : public Module {
   }
   // The same on every rank (a rank may own no point).
   bool semi_implicit() const { return semi_implicit_; }
-  // The pressure solve's Krylov method (PressureProjection: CG, or GMRES with image points).
+  // The pressure solve's Krylov method (PressureProjection: CG or RCG, or GMRES with image
+  // points).
   std::string pressure_solve_method() const {
     return projection_ ? projection_->method() : std::string();
   }

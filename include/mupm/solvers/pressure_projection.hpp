@@ -206,11 +206,11 @@ class PressureProjection {
   // The fracture pressures' gid offset in the joint numbering (CrackBlock).
   GlobalId crack_offset() const { return offset_; }
 
-  const std::string& method() const { return solver_.settings().method; }
+  std::string method() const { return solver_.method(); }
   // The bonds changed: assemble again before the next solve.
   void invalidate() { stale_ = true; }
-  // A checkpoint was written: the next step computes the preconditioner's factors, as a
-  // restart from it does (LinearSolve::renew).
+  // A checkpoint was written: the next step computes the preconditioner's factors and starts
+  // without a recycle space, as a restart from it does (LinearSolve::renew).
   void renew_preconditioner() { solver_.renew(); }
   long long assemblies() const { return assemblies_; }
 
