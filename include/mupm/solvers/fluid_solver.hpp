@@ -54,6 +54,7 @@
 #include <vector>
 
 #include "mupm/core/error.hpp"
+#include "mupm/core/scratch.hpp"
 #include "mupm/kernels/boundary_conditions.hpp"
 #include "mupm/kernels/fluid.hpp"
 #include "mupm/mesh/discretization.hpp"
@@ -541,7 +542,7 @@ class FluidSolver : public Module {
   double estimate_stable_dt(int iterations = 40) {
     ScopedRegion region("mupm::Fluid::stable_step");
     auto& p = disc_.points;
-    Scalars x("mupm::fluid_power_iterate", p.size());
+    const Scalars x = scratch_.scalars("power_iterate", p.size());
     const Operator op{x, st_.flow, st_.storage, p.fixed};
     const double lambda = largest_eigenvalue(
         op, 1, p.n_owned, p.gid, p.volume,
@@ -685,8 +686,7 @@ class FluidSolver : public Module {
   void mirror_pressure(const Scalars& x) {
     const auto m = disc_.mirror;
     const Bytes only = mirrored_;
-    Scalars src("mupm::mirror_sources", x.extent(0));
-    Kokkos::deep_copy(src, x);
+    const Scalars src = scratch_.copy("mirror_sources", x);
     Kokkos::parallel_for(
         "mupm::Fluid::mirror_perturbation", range(0, disc_.points.n_owned),
         KOKKOS_LAMBDA(const std::size_t i) {
@@ -920,6 +920,7 @@ class FluidSolver : public Module {
   SolveStats stats_;
   double solve_scale_ = 0;
   bool semi_implicit_ = false;
+  Scratch scratch_;  // estimate_stable_dt's iterate and mirror_pressure's sources
 };
 
 }  // namespace mupm

@@ -16,6 +16,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "mupm/core/scratch.hpp"
 #include "mupm/kernels/boundary_conditions.hpp"
 #include "mupm/kernels/central_difference.hpp"
 #include "mupm/kernels/fracture.hpp"
@@ -646,13 +647,8 @@ class SolidSolver : public Mechanics, public Skeleton {
   double estimate_stable_dt(int iterations = 40) {
     ScopedRegion region("mupm::Solid::stable_step");
     auto& p = disc_.points;
-    const std::size_t n = p.size();
-    Vectors u0("u0", n, Dim), t0("t0", n, R);
-    Kokkos::deep_copy(u0, p.u);
-    Kokkos::deep_copy(t0, p.theta);
-    Scalars p0("p0", n), ref0("ref0", n);
-    Kokkos::deep_copy(p0, p.p);
-    Kokkos::deep_copy(ref0, p.vol_strain_ref);
+    const Vectors u0 = scratch_.copy("u0", p.u), t0 = scratch_.copy("t0", p.theta);
+    const Scalars p0 = scratch_.copy("p0", p.p), ref0 = scratch_.copy("ref0", p.vol_strain_ref);
     Kokkos::deep_copy(p.p, 0.0);  // the operator's linear part only
     Kokkos::deep_copy(p.vol_strain_ref, 0.0);
     const BondWork work = st_.work;
@@ -668,10 +664,8 @@ class SolidSolver : public Mechanics, public Skeleton {
     Scalars keep[5];
     if (crack) {
       Scalars fields[5] = {p.pf, p.pf_saturation, p.pf_modulus, p.pf_aperture, p.pf_area};
-      for (int k = 0; k < 5; ++k) {
-        keep[k] = Scalars("keep", n);
-        Kokkos::deep_copy(keep[k], fields[k]);
-      }
+      for (int k = 0; k < 5; ++k)
+        keep[k] = scratch_.copy("crack" + std::to_string(k), fields[k]);
       // A point that joins has the face-area share of one row, V/dx (n_i = 1: the stiffest).
       const double joins = set_.fracture.water_modulus / set_.fracture.min_aperture;
       const double inv_dx = 1.0 / disc_.grid.dx;
@@ -985,7 +979,7 @@ class SolidSolver : public Mechanics, public Skeleton {
     std::vector<Vectors> kept;
     if constexpr (Law::plastic)
       for (const Vectors& v : plastic_current(disc_.points))
-        kept.push_back(copy_of(v));
+        kept.push_back(scratch_.copy("plastic" + std::to_string(kept.size()), v));
     f();
     for (std::size_t k = 0; k < kept.size(); ++k)
       Kokkos::deep_copy(plastic_current(disc_.points)[k], kept[k]);
@@ -1004,11 +998,6 @@ class SolidSolver : public Mechanics, public Skeleton {
             as_vectors(p.cohesion),
             as_vectors(p.stress_zz),
             as_vectors(p.vol_strain)};
-  }
-  static Vectors copy_of(const Vectors& f) {
-    Vectors c("mupm::kept", f.extent(0), f.extent(1));
-    Kokkos::deep_copy(c, f);
-    return c;
   }
 
   // The plastic law's current state becomes the start of the next step (the law's header).
@@ -1150,6 +1139,7 @@ class SolidSolver : public Mechanics, public Skeleton {
   bool pressure_ = false;                   // breakage run with pore pressure (initialize)
   bool keep_pore_part_ = false;             // P1w for the J-integral (keep_pore_part)
   std::function<Breakage(double)> driver_;  // the J criterion (set_crack_driver), at time t
+  Scratch scratch_;  // the fields estimate_stable_dt and keeping_plastic_state save
 };
 
 }  // namespace mupm
