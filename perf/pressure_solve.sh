@@ -11,8 +11,8 @@
 #   drained and pressed at 1 cm/s, 10 steps. cube100: the same at 100^3 = 1e6 points with
 #   delta = 1.5 dx (at 3.015 dx the projection's matrix, two horizons wide, would hold ~920
 #   entries a row: 11 GB at 1e6 points, and its ILU as much: beyond this machine's 24 GiB).
-# crack: inputs/example1_fluid_driven.xml (Example 1 case 1, 100 x 100, fracture flow: the crack
-#   water's pressure in the same solve, whose network rows change every step) with
+# crack: inputs/example1_fluid_driven_explicit.xml (Example 1 case 1, 100 x 100, fracture flow:
+#   the crack water's pressure in the same solve, whose network rows change every step) with
 #   incompressible water at the automatic step, 150 steps, the default Pressure Solve; crack-kept:
 #   the same with Drop Tolerance = 0 (the ILU of the whole matrix); crack-whole: also Preconditioner
 #   Refresh Interval = 1 (that ILU computed every step, as before both settings existed).
@@ -48,7 +48,7 @@ crack() {  # crack FOLDER DROP_TOLERANCE REFRESH_INTERVAL
   mapfile -t shared < <(shared_edits "$1")
   sed -E -e "s|<Parameter name=\"Physics\" type=\"string\" value=\"Hydro-Mechanical\"/>|&<Parameter name=\"Pressure Integration\" type=\"string\" value=\"Semi-Implicit\"/><ParameterList name=\"Pressure Solve\"><Parameter name=\"Drop Tolerance\" type=\"double\" value=\"$2\"/><Parameter name=\"Preconditioner Refresh Interval\" type=\"int\" value=\"$3\"/></ParameterList>|" \
     -e 's|<Parameter name="End Time" type="double" value="[^"]*"/>|<Parameter name="Number of Steps" type="int" value="150"/>|' \
-    "${shared[@]}" "$SRC/inputs/example1_fluid_driven.xml"
+    "${shared[@]}" "$SRC/inputs/example1_fluid_driven_explicit.xml"
 }
 source "$SRC/perf/cube_input.sh"
 cube() {  # cube FOLDER N HORIZON STEPS

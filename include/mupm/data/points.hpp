@@ -34,7 +34,8 @@ inline constexpr std::uint32_t kFixedPressure = 1u << 31;
 // states (include/mupm/kernels/solid.hpp), so the body's energy is its real points' alone.
 inline constexpr std::uint32_t kFixedNoEnergy = 1u << 30;
 
-inline constexpr std::uint32_t layer_face_flag(int axis, int side) {
+// Called in kernels (boundary conditions, the grid's fill): a device function.
+KOKKOS_INLINE_FUNCTION constexpr std::uint32_t layer_face_flag(int axis, int side) {
   return kFlagLayerFace0 << (2 * axis + side);
 }
 

@@ -82,8 +82,11 @@ struct JContours {
 // Per owned point i and contour c: out(i, 3c + 0) the W term, 3c + 1 the u terms, 3c + 2 the
 // theta terms (each already signed as it enters J, per unit thickness). u, theta, eps, kappa,
 // P1, P2, winv (and P1w when allocated) current on the ghosts, as solid pass 2 leaves them.
-inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const SolidParams& prm,
-                             const SolidState<2>& st, const JContours& jc, const Vectors& out) {
+// Effective: the bond forces include P1w's pore-water part (P1w allocated), a compile-time
+// choice so that the bond loop tests no run-time option (j_integral_terms dispatches).
+template <bool Effective>
+void j_integral_terms_variant(const Points<2>& pts, const Bonds& bonds, const SolidParams& prm,
+                              const SolidState<2>& st, const JContours& jc, const Vectors& out) {
   constexpr int Dim = 2, R = 1;
   auto offsets = bonds.offsets;
   auto neighbor = bonds.neighbor;
@@ -92,7 +95,6 @@ inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const Sol
   auto vol = pts.volume;
   auto eps = st.eps, kap = st.kappa, P1 = st.P1, P2 = st.P2, P1w = st.P1w;
   auto winv = st.winv, energy = st.energy;
-  const bool effective = P1w.extent(0) > 0;
   const double c1 = prm.stabilization * 12.0 * prm.stab_modulus;
   const double c2 = prm.stabilization * prm.stab_modulus;
   const JContours c = jc;
@@ -157,7 +159,7 @@ inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const Sol
                   pj += P1(j, d * Dim + k) * xi[k];
                   ei += eps(i, d * Dim + k) * xi[k];
                   ej += eps(j, d * Dim + k) * xi[k];
-                  if (effective) {
+                  if constexpr (Effective) {
                     wi += P1w(i, d * Dim + k) * xi[k];
                     wj += P1w(j, d * Dim + k) * xi[k];
                   }
@@ -189,6 +191,14 @@ inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const Sol
           out(i, 3 * ci + 2) = rot;
         }
       });
+}
+
+inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const SolidParams& prm,
+                             const SolidState<2>& st, const JContours& jc, const Vectors& out) {
+  if (st.P1w.extent(0) > 0)
+    j_integral_terms_variant<true>(pts, bonds, prm, st, jc, out);
+  else
+    j_integral_terms_variant<false>(pts, bonds, prm, st, jc, out);
 }
 
 }  // namespace mupm
