@@ -547,7 +547,8 @@ RCP<ParameterList> valid_parameters() {
              "smallest eigenvalues, this many, gathered over the steps and deflated from every "
              "later solve, for this many extra products and preconditioner applies per step. "
              "Pays where a solve takes many iterations (Example 1 case 1 at 100 x 100: 54 "
-             "iterations become 17, the solve 1.3 times faster with 10, perf/README.md). The "
+             "preconditioner applies a step become 28, the solve 1.3 times faster with 10, "
+             "perf/README.md). The "
              "space is dropped at each checkpoint, so a restart continues bit for bit. Not "
              "used with GMRES (mirrored pressure layers). 0: CG.",
              at_least(0));
