@@ -98,15 +98,6 @@ struct LinearSolve::Impl {
   Teuchos::RCP<TpetraVector> x0, r0;
 };
 
-namespace {
-// `kept`, made anew only when `like`'s map is not its own.
-TpetraVector& work(Teuchos::RCP<TpetraVector>& kept, const TpetraVector& like) {
-  if (kept.is_null() || kept->getMap().get() != like.getMap().get())
-    kept = Teuchos::rcp(new TpetraVector(like.getMap(), false));
-  return *kept;
-}
-}  // namespace
-
 LinearSolve::LinearSolve(const LinearSolveSettings& settings)
     : set_(settings), impl_(Teuchos::rcp(new Impl)) {
   if (set_.preconditioner != "ILU" && set_.preconditioner != "Jacobi" &&
@@ -281,7 +272,7 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
   // RCG tests ||r|| against the initial residual's norm rn, CG and GMRES against ||b||.
   double rn = bn;
   if (method() == "RCG") {
-    TpetraVector& r0 = work(impl_->r0, b);
+    TpetraVector& r0 = kept_vector(impl_->r0, b.getMap());
     impl_->a->apply(x, r0);
     r0.update(1.0, b, -1.0);
     rn = r0.norm2();
@@ -308,7 +299,7 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
   // ILU is therefore tried again from the same initial guess: with the ILU of this matrix's
   // values where the factors were of earlier ones (refresh_interval), else with Jacobi, kept
   // for this matrix's values. Otherwise a failed solve, for the caller to report.
-  TpetraVector& x0 = work(impl_->x0, x);
+  TpetraVector& x0 = kept_vector(impl_->x0, x.getMap());
   x0.assign(x);
   if (forget_)
     new_krylov();

@@ -24,6 +24,14 @@ namespace mupm {
 using CrsMatrix = Tpetra::CrsMatrix<double, LocalId, GlobalId>;
 using TpetraVector = Tpetra::Vector<double, LocalId, GlobalId>;
 
+// A work vector kept between calls: `kept`, made anew (zeroed) only when it is not over `map`.
+inline TpetraVector& kept_vector(Teuchos::RCP<TpetraVector>& kept,
+                                 const Teuchos::RCP<const TpetraVector::map_type>& map) {
+  if (kept.is_null() || kept->getMap().get() != map.get())
+    kept = Teuchos::rcp(new TpetraVector(map));
+  return *kept;
+}
+
 struct LinearSolveSettings {
   // "GMRES" | "CG": CG needs a symmetric positive definite matrix and preconditioner (ILU(k) of
   // a symmetric matrix is L D L^T up to round-off); it keeps no basis, so an iteration costs a

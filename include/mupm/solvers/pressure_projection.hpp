@@ -714,10 +714,7 @@ class PressureProjection {
   enum Work { kDu, kBp, kB, kC, kAc, kX, kY, kE, kFe, kBe, kYp, kF, kFlowX, kFlowY, kWorks };
   mutable std::array<Teuchos::RCP<TpetraVector>, kWorks> work_;
   TpetraVector& work(Work w, const Teuchos::RCP<const Map>& map) const {
-    auto& v = work_[w];
-    if (v.is_null() || v->getMap().get() != map.get())
-      v = Teuchos::rcp(new TpetraVector(map));
-    return *v;
+    return kept_vector(work_[w], map);
   }
   // flow_, coupling_: over the points; the others over the joint map (static_: the system's
   // rows but the network's of the step, before R and S; composed_: after them).
