@@ -4,8 +4,10 @@
 //
 // - BM_ScalarMulAdd: a*x + y on scalars in 12 independent chains, one scalar mul and add each
 //   (vectorization off): what a kernel whose bond loop the compiler does not vectorize can reach
-//   in the generic x86-64 build mupm makes (SSE2, no FMA instruction). 2 flops an element.
+//   in the generic x86-64 build (MUPM_NATIVE=OFF: SSE2, no FMA instruction). 2 flops an element.
 // - BM_Sse2MulAdd: the same, vectorized by the compiler to SSE2 (2 doubles a register).
+//   Both are compiled without AVX (target "no-avx", which also removes AVX2, FMA and AVX-512),
+//   so that they measure the same instructions in the default -march=native build.
 // - BM_VectorFma: the same on arrays the compiler vectorizes, with the core's widest FMA
 //   (target attribute: AVX-512F where the core has it, else AVX2 + FMA; both chosen at run time).
 // - BM_StreamTriad: a = b + s c over arrays of 3 x 64 MiB, OpenMP threads (24 bytes an element
@@ -24,14 +26,14 @@ namespace {
 constexpr int kChains = 12;
 constexpr long kRounds = 1 << 20;
 
-__attribute__((noinline, optimize("no-tree-vectorize"))) void scalar_rounds(double* acc,
-                                                                            long rounds) {
+__attribute__((noinline, optimize("no-tree-vectorize"), target("no-avx"))) void scalar_rounds(
+    double* acc, long rounds) {
   const double a = 0.999999, x = 1e-9;
   for (long r = 0; r < rounds; ++r)
     for (int c = 0; c < kChains; ++c)
       acc[c] = a * acc[c] + x;
 }
-__attribute__((noinline)) void sse2_rounds(double* acc, long rounds) {
+__attribute__((noinline, target("no-avx"))) void sse2_rounds(double* acc, long rounds) {
   const double a = 0.999999, x = 1e-9;
   for (long r = 0; r < rounds; ++r)
     for (int c = 0; c < kChains; ++c)

@@ -139,6 +139,18 @@ KOKKOS_INLINE_FUNCTION double bond_kinematics(const X& x, const U& u, const T& t
   return len2;
 }
 
+// Both passes take a family's bonds kBondLanes at a time: a gather loop copies each bond's
+// neighbour rows into lane arrays, one loop over the lanes, which the compiler vectorizes
+// (`GCC ivdep`; no branch: a broken bond or a padding lane counts with a zero volume), computes
+// each bond's terms into per-lane sums or pair states, and the lanes are summed in a fixed order
+// at the end. Pass 2 then records and accumulates the bond energy bond by bond from the lanes'
+// pair states. Every lane evaluates the scalar expressions operation for operation (IEEE; the
+// build contracts nothing into FMAs, CMakeLists.txt), so both ends of a bond still hold exactly
+// negated pair states. Only the order of a family's sums (lane by lane, then the lanes in order)
+// differs from a plain loop, and it is the same on any rank or thread count.
+template <int Dim>
+constexpr int kBondLanes = Dim == 2 ? 16 : 8;  // measured best (perf/README.md)
+
 // Pass 1 (per owned point): eps, kappa (with K^-1 of the shape-tensor cache), the constitutive
 // update by `law` (sigma-bar, m into pts.stress, pts.couple_stress), Q1, Q2, and the point's
 // energy. Law: a pointwise micropolar law with
@@ -206,40 +218,103 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
         // below include V_j). The energy is now a difference of sums that nearly cancel where
         // the field is nearly affine: its round-off is that of s1, and a point's stabilization
         // energy may come out a few ulps of s1 below zero (energies only; the forces take Q).
+        // The sums are taken in lanes (kBondLanes, above), each lane's own, then added in order.
         constexpr int NS = Dim * (Dim + 1) / 2;  // Mg: symmetric, upper triangle by rows
+        constexpr int L = kBondLanes<Dim>;
+        double lA[Dim * Dim][L] = {}, lB[R * Dim][L] = {}, lAg[Dim * Dim][L] = {},
+                        lBg[R * Dim][L] = {}, lM1[NS][L] = {}, lM2[NS][L] = {}, ls1[L] = {},
+                        ls2[L] = {};
+        double xo[Dim], uo[Dim], to[R];
+        for (int d = 0; d < Dim; ++d) {
+          xo[d] = x(i, d);
+          uo[d] = u(i, d);
+        }
+        for (int r = 0; r < R; ++r)
+          to[r] = th(i, r);
+        const BondIndex end = offsets(i + 1);
+        for (BondIndex b0 = offsets(i); b0 < end; b0 += L) {
+          const int n = end - b0 < L ? int(end - b0) : L;
+          double gx[Dim][L], gu[Dim][L], gt[R][L], gv[L];
+          for (int q = 0; q < L; ++q) {
+            const BondIndex b = b0 + (q < n ? q : n - 1);
+            const int j = neighbor(b);
+            gv[q] = q < n && intact(b) ? vol(j) : 0.0;
+            for (int d = 0; d < Dim; ++d) {
+              gx[d][q] = x(j, d);
+              gu[d][q] = u(j, d);
+            }
+            for (int r = 0; r < R; ++r)
+              gt[r][q] = th(j, r);
+          }
+#pragma GCC ivdep
+          for (int q = 0; q < L; ++q) {
+            const double vj = gv[q];
+            double xi[Dim], uh[Dim], om[R], tb[R], c[Dim], len2 = 0;
+#pragma GCC unroll 16
+            for (int d = 0; d < Dim; ++d) {
+              xi[d] = gx[d][q] - xo[d];
+              len2 += xi[d] * xi[d];
+            }
+#pragma GCC unroll 16
+            for (int r = 0; r < R; ++r) {
+              tb[r] = 0.5 * (to[r] + gt[r][q]);
+              om[r] = gt[r][q] - to[r];
+            }
+            rot_cross<Dim>(tb, xi, c);
+#pragma GCC unroll 16
+            for (int d = 0; d < Dim; ++d)
+              uh[d] = gu[d][q] - uo[d] - c[d];
+            const double il = 1.0 / std::sqrt(len2);
+            const double g1 = c1 * il * il * il * vj, g2 = c2 * il * vj;
+            double xv[Dim];
+#pragma GCC unroll 16
+            for (int k = 0; k < Dim; ++k)
+              xv[k] = xi[k] * vj;
+#pragma GCC unroll 16
+            for (int a = 0; a < Dim; ++a) {
+              ls1[q] += g1 * uh[a] * uh[a];
+#pragma GCC unroll 16
+              for (int k = 0; k < Dim; ++k) {
+                lA[a * Dim + k][q] += uh[a] * xv[k];  // U^ (x) xi (eq 50)
+                lAg[a * Dim + k][q] += g1 * uh[a] * xi[k];
+              }
+            }
+#pragma GCC unroll 16
+            for (int r = 0; r < R; ++r) {
+              ls2[q] += g2 * om[r] * om[r];
+#pragma GCC unroll 16
+              for (int k = 0; k < Dim; ++k) {
+                lB[r * Dim + k][q] += om[r] * xv[k];  // eq 51
+                lBg[r * Dim + k][q] += g2 * om[r] * xi[k];
+              }
+            }
+#pragma GCC unroll 16
+            for (int k = 0; k < Dim; ++k)
+#pragma GCC unroll 16
+              for (int l = k; l < Dim; ++l) {
+                const int n2 = k * Dim - k * (k - 1) / 2 + (l - k);
+                lM1[n2][q] += g1 * xi[k] * xi[l];
+                lM2[n2][q] += g2 * xi[k] * xi[l];
+              }
+          }
+        }
         double A[Dim * Dim] = {}, B[R * Dim] = {}, Ag[Dim * Dim] = {}, Bg[R * Dim] = {};
         double Mg1[NS] = {}, Mg2[NS] = {}, s1 = 0, s2 = 0;
-        for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
-          if (!intact(b))
-            continue;
-          const int j = neighbor(b);
-          const double vj = vol(j);
-          double xi[Dim], uh[Dim], om[R];
-          const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, uh, om);
-          const double il = 1.0 / std::sqrt(len2);
-          const double g1 = c1 * il * il * il * vj, g2 = c2 * il * vj;
-          double xv[Dim];
-          for (int k = 0; k < Dim; ++k)
-            xv[k] = xi[k] * vj;
-          for (int a = 0; a < Dim; ++a) {
-            s1 += g1 * uh[a] * uh[a];
-            for (int k = 0; k < Dim; ++k) {
-              A[a * Dim + k] += uh[a] * xv[k];  // U^ (x) xi (eq 50)
-              Ag[a * Dim + k] += g1 * uh[a] * xi[k];
-            }
+        for (int q = 0; q < L; ++q) {
+          for (int k = 0; k < Dim * Dim; ++k) {
+            A[k] += lA[k][q];
+            Ag[k] += lAg[k][q];
           }
-          for (int r = 0; r < R; ++r) {
-            s2 += g2 * om[r] * om[r];
-            for (int k = 0; k < Dim; ++k) {
-              B[r * Dim + k] += om[r] * xv[k];  // eq 51
-              Bg[r * Dim + k] += g2 * om[r] * xi[k];
-            }
+          for (int k = 0; k < R * Dim; ++k) {
+            B[k] += lB[k][q];
+            Bg[k] += lBg[k][q];
           }
-          for (int k = 0, n = 0; k < Dim; ++k)
-            for (int l = k; l < Dim; ++l, ++n) {
-              Mg1[n] += g1 * xi[k] * xi[l];
-              Mg2[n] += g2 * xi[k] * xi[l];
-            }
+          for (int k = 0; k < NS; ++k) {
+            Mg1[k] += lM1[k][q];
+            Mg2[k] += lM2[k][q];
+          }
+          s1 += ls1[q];
+          s2 += ls2[q];
         }
         double Kinv[Dim * Dim], eps[Dim * Dim] = {}, kap[R * Dim] = {};
         for (int k = 0; k < Dim * Dim; ++k)
@@ -361,6 +436,8 @@ template <int Dim, class V>
 void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const SolidParams& prm,
                          SolidState<Dim>& st) {
   constexpr int R = kRotDim<Dim>;
+  constexpr int L = kBondLanes<Dim>;
+  constexpr int D2 = Dim * Dim, RD = R * Dim;
   auto offsets = bonds.offsets;
   auto neighbor = bonds.neighbor;
   auto intact = bonds.intact;
@@ -379,102 +456,198 @@ void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const Solid
       "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         double f[Dim] = {}, l[R] = {}, wm = 0, f17[Dim + R] = {};
         // The owned point's rows, read once (the bond loop's stores could alias them).
-        double P1i[Dim * Dim], Ei[Dim * Dim], P2i[R * Dim], Ki[R * Dim];
-        for (int k = 0; k < Dim * Dim; ++k) {
+        double xo[Dim], uo[Dim], to[R], P1i[D2], Ei[D2], P2i[RD], Ki[RD], P1fi[D2] = {};
+        for (int d = 0; d < Dim; ++d) {
+          xo[d] = x(i, d);
+          uo[d] = u(i, d);
+        }
+        for (int r = 0; r < R; ++r)
+          to[r] = th(i, r);
+        for (int k = 0; k < D2; ++k) {
           P1i[k] = P1(i, k);
           Ei[k] = eps(i, k);
+          if constexpr (V::eq17)
+            P1fi[k] = P1f(i, k);
         }
-        for (int k = 0; k < R * Dim; ++k) {
+        for (int k = 0; k < RD; ++k) {
           P2i[k] = P2(i, k);
           Ki[k] = kap(i, k);
         }
         const double winv_i = winv(i);
-        for (BondIndex b = offsets(i); b < offsets(i + 1); ++b) {
-          if (!intact(b))
-            continue;
-          const int j = neighbor(b);
-          const double vj = vol(j);
-          double xi[Dim], Uh[Dim], Om[R];
-          const double len2 = bond_kinematics<Dim>(x, u, th, int(i), j, xi, Uh, Om);
-          const double il = 1.0 / std::sqrt(len2);
-          const double a1 = c1 * (il * il * il), a2 = c2 * il;  // eqs 66-70 with w0 = 1
-          const double a1i = a1 * winv_i, a2i = a2 * winv_i, a1j = a1 * winv(j), a2j = a2 * winv(j);
-          // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
-          //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
-          double t[Dim], m[R], cf[Dim] = {};
-          if constexpr (V::eq17)
-            if (srf(i) > 0 && srf(j) > 0) {  // eq 17: the fracture bond's water is p_f's
+        const bool net_i = V::eq17 && srf(i) > 0;
+        const BondIndex end = offsets(i + 1);
+        for (BondIndex b0 = offsets(i); b0 < end; b0 += L) {
+          const int n = end - b0 < L ? int(end - b0) : L;
+          // Gather: lane q holds bond b0 + q (padding lanes repeat the last bond, weight 0).
+          double gx[Dim][L], gu[Dim][L], gt[R][L], gP1[D2][L], gE[D2][L], gP2[RD][L], gK[RD][L];
+          double gw[L], gv[L], gf[D2][L], gn[L];
+          for (int q = 0; q < L; ++q) {
+            const BondIndex b = b0 + (q < n ? q : n - 1);
+            const int j = neighbor(b);
+            gv[q] = q < n && intact(b) ? vol(j) : 0.0;
+            gw[q] = winv(j);
+            for (int d = 0; d < Dim; ++d) {
+              gx[d][q] = x(j, d);
+              gu[d][q] = u(j, d);
+            }
+            for (int r = 0; r < R; ++r)
+              gt[r][q] = th(j, r);
+            for (int k = 0; k < D2; ++k) {
+              gP1[k][q] = P1(j, k);
+              gE[k][q] = eps(j, k);
+            }
+            for (int k = 0; k < RD; ++k) {
+              gP2[k][q] = P2(j, k);
+              gK[k][q] = kap(j, k);
+            }
+            if constexpr (V::eq17) {
+              gn[q] = net_i && srf(j) > 0 ? 1.0 : 0.0;
+              for (int k = 0; k < D2; ++k)
+                gf[k][q] = P1f(j, k);
+            }
+          }
+          // Per lane: xi, the pair states T_ij - T_ji (t) and M_ij - M_ji (m), and their terms.
+          double lxi[Dim][L], lt[Dim][L], lm[R][L], lf[Dim][L], ll[R][L], l17[Dim + R][L];
+#pragma GCC ivdep
+          for (int q = 0; q < L; ++q) {
+            const double vj = gv[q];
+            double xi[Dim], Uh[Dim], Om[R], tb[R], c[Dim], len2 = 0;
+#pragma GCC unroll 16
+            for (int d = 0; d < Dim; ++d) {
+              xi[d] = gx[d][q] - xo[d];
+              len2 += xi[d] * xi[d];
+            }
+#pragma GCC unroll 16
+            for (int r = 0; r < R; ++r) {
+              tb[r] = 0.5 * (to[r] + gt[r][q]);
+              Om[r] = gt[r][q] - to[r];
+            }
+            rot_cross<Dim>(tb, xi, c);
+#pragma GCC unroll 16
+            for (int d = 0; d < Dim; ++d)
+              Uh[d] = gu[d][q] - uo[d] - c[d];
+            const double il = 1.0 / std::sqrt(len2);
+            const double a1 = c1 * (il * il * il), a2 = c2 * il;  // eqs 66-70 with w0 = 1
+            const double a1i = a1 * winv_i, a2i = a2 * winv_i, a1j = a1 * gw[q], a2j = a2 * gw[q];
+            // T_ij - T_ji with xi_ji = -xi, U^_ji = -U^_ij:
+            //   T_ij = P1_i xi + a1i (U^ - eps_i xi),  T_ji = -P1_j xi - a1j (U^ - eps_j xi).
+            double cf[Dim] = {};
+            if constexpr (V::eq17) {  // eq 17: a fracture bond's water is p_f's
+#pragma GCC unroll 16
               for (int a = 0; a < Dim; ++a) {
                 double ci = 0, cj = 0;
+#pragma GCC unroll 16
                 for (int k = 0; k < Dim; ++k) {
-                  ci += P1f(i, a * Dim + k) * xi[k];
-                  cj += P1f(j, a * Dim + k) * xi[k];
+                  ci += P1fi[a * Dim + k] * xi[k];
+                  cj += gf[a * Dim + k][q] * xi[k];
                 }
-                cf[a] = ci + cj;
+                cf[a] = gn[q] * (ci + cj);
               }
               double xc[R];
               cross<Dim>(xi, cf, xc);
+#pragma GCC unroll 16
               for (int a = 0; a < Dim; ++a)
-                f17[a] += cf[a] * vj;
+                l17[a][q] = cf[a] * vj;
+#pragma GCC unroll 16
               for (int r = 0; r < R; ++r)
-                f17[Dim + r] += 0.5 * xc[r] * vj;
+                l17[Dim + r][q] = 0.5 * xc[r] * vj;
             }
-          for (int a = 0; a < Dim; ++a) {
-            double pi = 0, pj = 0, ei = 0, ej = 0;
-            for (int k = 0; k < Dim; ++k) {
-              pi += P1i[a * Dim + k] * xi[k];
-              pj += P1(j, a * Dim + k) * xi[k];
-              ei += Ei[a * Dim + k] * xi[k];
-              ej += eps(j, a * Dim + k) * xi[k];
-            }
-            t[a] = ((pi + pj) + (a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej))) + cf[a];
-            f[a] += t[a] * vj;
-          }
-          // M_ij - M_ji, Omega_ji = -Omega_ij.
-          for (int r = 0; r < R; ++r) {
-            double pi = 0, pj = 0, ki = 0, kj = 0;
-            for (int k = 0; k < Dim; ++k) {
-              pi += P2i[r * Dim + k] * xi[k];
-              pj += P2(j, r * Dim + k) * xi[k];
-              ki += Ki[r * Dim + k] * xi[k];
-              kj += kap(j, r * Dim + k) * xi[k];
-            }
-            m[r] = (pi + pj) + (a2i * (Om[r] - ki) + a2j * (Om[r] - kj));
-            l[r] += m[r] * vj;
-          }
-          double xt[R];
-          cross<Dim>(xi, t, xt);  // 1/2 xi x (T_ij - T_ji)
-          for (int r = 0; r < R; ++r)
-            l[r] += 0.5 * xt[r] * vj;
-          if constexpr (V::record) {
-            if constexpr (V::effective)  // take out -(S_r p* K^-1 xi) of both ends (header)
-              for (int a = 0; a < Dim; ++a) {
-                double wi = 0, wj = 0;
-                for (int k = 0; k < Dim; ++k) {
-                  wi += P1w(i, a * Dim + k) * xi[k];
-                  wj += P1w(j, a * Dim + k) * xi[k];
-                }
-                t[a] += (wi + wj) - cf[a];  // the bond's water part, whichever pressure
+            double t[Dim], m[R];
+#pragma GCC unroll 16
+            for (int a = 0; a < Dim; ++a) {
+              double pi = 0, pj = 0, ei = 0, ej = 0;
+#pragma GCC unroll 16
+              for (int k = 0; k < Dim; ++k) {
+                pi += P1i[a * Dim + k] * xi[k];
+                pj += gP1[a * Dim + k][q] * xi[k];
+                ei += Ei[a * Dim + k] * xi[k];
+                ej += gE[a * Dim + k][q] * xi[k];
               }
-            if constexpr (V::accumulate) {
-              // dU^ = d(u_j - u_i) - (d theta_i + d theta_j)/2 x xi, dOmega = d theta_j - d
-              // theta_i.
-              double tb[R], c[Dim], dw = 0;
-              for (int r = 0; r < R; ++r)
-                tb[r] = 0.5 * (inc(i, Dim + r) + inc(j, Dim + r));
-              rot_cross<Dim>(tb, xi, c);
-              for (int a = 0; a < Dim; ++a)
-                dw += 0.5 * (pair(b, a) + t[a]) * (inc(j, a) - inc(i, a) - c[a]);
-              for (int r = 0; r < R; ++r)
-                dw += 0.5 * (pair(b, Dim + r) + m[r]) * (inc(j, Dim + r) - inc(i, Dim + r));
-              W(b) += dw;
-              wm = W(b) > wm ? W(b) : wm;
+              t[a] = ((pi + pj) + (a1i * (Uh[a] - ei) + a1j * (Uh[a] - ej))) + cf[a];
             }
-            for (int a = 0; a < Dim; ++a)
-              pair(b, a) = t[a];
-            for (int r = 0; r < R; ++r)
-              pair(b, Dim + r) = m[r];
+// M_ij - M_ji, Omega_ji = -Omega_ij.
+#pragma GCC unroll 16
+            for (int r = 0; r < R; ++r) {
+              double pi = 0, pj = 0, ki = 0, kj = 0;
+#pragma GCC unroll 16
+              for (int k = 0; k < Dim; ++k) {
+                pi += P2i[r * Dim + k] * xi[k];
+                pj += gP2[r * Dim + k][q] * xi[k];
+                ki += Ki[r * Dim + k] * xi[k];
+                kj += gK[r * Dim + k][q] * xi[k];
+              }
+              m[r] = (pi + pj) + (a2i * (Om[r] - ki) + a2j * (Om[r] - kj));
+            }
+            double xt[R];
+            cross<Dim>(xi, t, xt);  // 1/2 xi x (T_ij - T_ji)
+#pragma GCC unroll 16
+            for (int a = 0; a < Dim; ++a) {
+              lxi[a][q] = xi[a];
+              lt[a][q] = t[a];
+              lf[a][q] = t[a] * vj;
+            }
+#pragma GCC unroll 16
+            for (int r = 0; r < R; ++r) {
+              lm[r][q] = m[r];
+              ll[r][q] = m[r] * vj + 0.5 * xt[r] * vj;
+            }
           }
+          for (int q = 0; q < L; ++q) {
+            for (int a = 0; a < Dim; ++a)
+              f[a] += lf[a][q];
+            for (int r = 0; r < R; ++r)
+              l[r] += ll[r][q];
+            if constexpr (V::eq17)
+              for (int c = 0; c < Dim + R; ++c)
+                f17[c] += l17[c][q];
+          }
+          if constexpr (V::record)
+            for (int q = 0; q < n; ++q) {
+              const BondIndex b = b0 + q;
+              if (!intact(b))
+                continue;
+              const int j = neighbor(b);
+              double t[Dim], m[R], xi[Dim];
+              for (int a = 0; a < Dim; ++a) {
+                t[a] = lt[a][q];
+                xi[a] = lxi[a][q];
+              }
+              for (int r = 0; r < R; ++r)
+                m[r] = lm[r][q];
+              if constexpr (V::effective)  // take out -(S_r p* K^-1 xi) of both ends (header)
+                for (int a = 0; a < Dim; ++a) {
+                  double wi = 0, wj = 0, ci = 0, cj = 0;
+                  for (int k = 0; k < Dim; ++k) {
+                    wi += P1w(i, a * Dim + k) * xi[k];
+                    wj += P1w(j, a * Dim + k) * xi[k];
+                    if constexpr (V::eq17) {
+                      ci += P1fi[a * Dim + k] * xi[k];
+                      cj += P1f(j, a * Dim + k) * xi[k];
+                    }
+                  }
+                  // the bond's water part, whichever pressure (cf as the lane computed it)
+                  const double cf = V::eq17 ? gn[q] * (ci + cj) : 0.0;
+                  t[a] += (wi + wj) - cf;
+                }
+              if constexpr (V::accumulate) {
+                // dU^ = d(u_j - u_i) - (d theta_i + d theta_j)/2 x xi, dOmega = d theta_j - d
+                // theta_i.
+                double tb[R], c[Dim], dw = 0;
+                for (int r = 0; r < R; ++r)
+                  tb[r] = 0.5 * (inc(i, Dim + r) + inc(j, Dim + r));
+                rot_cross<Dim>(tb, xi, c);
+                for (int a = 0; a < Dim; ++a)
+                  dw += 0.5 * (pair(b, a) + t[a]) * (inc(j, a) - inc(i, a) - c[a]);
+                for (int r = 0; r < R; ++r)
+                  dw += 0.5 * (pair(b, Dim + r) + m[r]) * (inc(j, Dim + r) - inc(i, Dim + r));
+                W(b) += dw;
+                wm = W(b) > wm ? W(b) : wm;
+              }
+              for (int a = 0; a < Dim; ++a)
+                pair(b, a) = t[a];
+              for (int r = 0; r < R; ++r)
+                pair(b, Dim + r) = m[r];
+            }
         }
         for (int d = 0; d < Dim; ++d)
           force(i, d) = f[d];
