@@ -115,7 +115,9 @@ KOKKOS_INLINE_FUNCTION double stored_energy_density(const VanGenuchten& vg, doub
   for (int k = 0; k < 4; ++k)
     for (int sign = -1; sign <= 1; sign += 2) {
       const double q = 0.5 * p * (1 + sign * x[k]);  // nodes on [p, 0]
-      s += w[k] * phi * (vg.dsaturation_dp(q) + vg.saturation(q) * inv_kw) * q;
+      double sq, dsq;
+      vg.saturation_and_slope(q, sq, dsq);
+      s += w[k] * phi * (dsq + sq * inv_kw) * q;
     }
   return 0.5 * p * s +
          0.5 * cz * sp * sp;  // int_0^p f dq = (p/2) sum_k w_k f(q_k), nodes on [p, 0]
@@ -160,10 +162,10 @@ void fluid_constitutive(const Points<Dim>& pts, const FluidParams& prm, FluidSta
   const double biot = prm.pore.biot, cz = prm.pore.lateral_compliance;
   Kokkos::parallel_for(
       "mupm::Fluid::constitutive", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
-        const double s = vg.saturation(p(i));
+        double s, ds;
+        vg.saturation_and_slope(p(i), s, ds);
         sr(i) = s;
         kr(i) = vg.relative_permeability(s);
-        const double ds = vg.dsaturation_dp(p(i));
         const double c = phi(i) * (ds + s * inv_kw) + cz * s * (s + p(i) * ds);
         C(i) = c;
         bu(i) = !split || (fixed(i) & kFixedPressure) || !(c > 0) ? 0.0 : biot * s / c;

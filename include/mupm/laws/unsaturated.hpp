@@ -30,13 +30,24 @@ struct VanGenuchten {
     return std::pow(1 + std::pow(-p / air_entry, n), -m);
   }
   // dS_r/dp = m n (s/s_a)^(n-1) [1 + (s/s_a)^n]^(-m-1) / s_a with s = -p (>= 0: drying lowers
-  // S_r as p falls).
+  // S_r as p falls), written m n (x^n / x) (S_r / (1 + x^n)) / s_a with x = s/s_a: the two powers
+  // of S_r itself instead of three more.
   KOKKOS_INLINE_FUNCTION double dsaturation_dp(double p) const {
-    if (!enabled || p >= 0)
-      return 0.0;
-    const double s = -p / air_entry;
-    const double sn = std::pow(s, n);
-    return m * n * std::pow(s, n - 1) * std::pow(1 + sn, -m - 1) / air_entry;
+    double s_r, ds;
+    saturation_and_slope(p, s_r, ds);
+    return ds;
+  }
+  // S_r (the same bits as saturation()) and dS_r/dp together, from two powers.
+  KOKKOS_INLINE_FUNCTION void saturation_and_slope(double p, double& s_r, double& ds) const {
+    if (!enabled || p >= 0) {
+      s_r = 1.0;
+      ds = 0.0;
+      return;
+    }
+    const double x = -p / air_entry;
+    const double xn = std::pow(x, n);
+    s_r = std::pow(1 + xn, -m);
+    ds = m * n * (xn / x) * (s_r / (1 + xn)) / air_entry;
   }
   KOKKOS_INLINE_FUNCTION double relative_permeability(double sr) const {
     if (!enabled || sr >= 1)
