@@ -151,6 +151,61 @@ KOKKOS_INLINE_FUNCTION double bond_kinematics(const X& x, const U& u, const T& t
 template <int Dim>
 constexpr int kBondLanes = Dim == 2 ? 16 : 8;  // measured best (perf/README.md)
 
+// A block of kBondLanes bonds of point i: its own x, u, theta, and each lane's neighbour's with
+// the neighbour's volume (0 for a broken bond or a padding lane, which repeats the block's last
+// bond). Both passes gather into it and take each lane's kinematics from it.
+template <int Dim>
+struct BondLanes {
+  static constexpr int R = kRotDim<Dim>;
+  static constexpr int L = kBondLanes<Dim>;
+  double xo[Dim], uo[Dim], to[R];
+  double x[Dim][L], u[Dim][L], t[R][L], v[L];
+
+  template <class X, class U, class T>
+  KOKKOS_INLINE_FUNCTION void owner(const X& xv, const U& uv, const T& th, std::size_t i) {
+    for (int d = 0; d < Dim; ++d) {
+      xo[d] = xv(i, d);
+      uo[d] = uv(i, d);
+    }
+    for (int r = 0; r < R; ++r)
+      to[r] = th(i, r);
+  }
+  // Lane q of the block of n bonds from b0; returns the lane's neighbour.
+  template <class N, class I, class V, class X, class U, class T>
+  KOKKOS_INLINE_FUNCTION int gather(int q, BondIndex b0, int n, const N& neighbor, const I& intact,
+                                    const V& vol, const X& xv, const U& uv, const T& th) {
+    const BondIndex b = b0 + (q < n ? q : n - 1);
+    const int j = neighbor(b);
+    v[q] = q < n && intact(b) ? vol(j) : 0.0;
+    for (int d = 0; d < Dim; ++d) {
+      x[d][q] = xv(j, d);
+      u[d][q] = uv(j, d);
+    }
+    for (int r = 0; r < R; ++r)
+      t[r][q] = th(j, r);
+    return j;
+  }
+  // Lane q's bond kinematics (eqs 2-9, as bond_kinematics): xi, U^, Omega; returns |xi|^2.
+  KOKKOS_INLINE_FUNCTION double kinematics(int q, double* xi, double* uh, double* om) const {
+    double tb[R], c[Dim], len2 = 0;
+#pragma GCC unroll 16
+    for (int d = 0; d < Dim; ++d) {
+      xi[d] = x[d][q] - xo[d];
+      len2 += xi[d] * xi[d];
+    }
+#pragma GCC unroll 16
+    for (int r = 0; r < R; ++r) {
+      tb[r] = 0.5 * (to[r] + t[r][q]);
+      om[r] = t[r][q] - to[r];
+    }
+    rot_cross<Dim>(tb, xi, c);
+#pragma GCC unroll 16
+    for (int d = 0; d < Dim; ++d)
+      uh[d] = u[d][q] - uo[d] - c[d];
+    return len2;
+  }
+};
+
 // Pass 1 (per owned point): eps, kappa (with K^-1 of the shape-tensor cache), the constitutive
 // update by `law` (sigma-bar, m into pts.stress, pts.couple_stress), Q1, Q2, and the point's
 // energy. Law: a pointwise micropolar law with
@@ -224,46 +279,18 @@ void solid_pass1(const Points<Dim>& pts, const Bonds& bonds, const ShapeTensors<
         double lA[Dim * Dim][L] = {}, lB[R * Dim][L] = {}, lAg[Dim * Dim][L] = {},
                         lBg[R * Dim][L] = {}, lM1[NS][L] = {}, lM2[NS][L] = {}, ls1[L] = {},
                         ls2[L] = {};
-        double xo[Dim], uo[Dim], to[R];
-        for (int d = 0; d < Dim; ++d) {
-          xo[d] = x(i, d);
-          uo[d] = u(i, d);
-        }
-        for (int r = 0; r < R; ++r)
-          to[r] = th(i, r);
+        BondLanes<Dim> g;
+        g.owner(x, u, th, i);
         const BondIndex end = offsets(i + 1);
         for (BondIndex b0 = offsets(i); b0 < end; b0 += L) {
           const int n = end - b0 < L ? int(end - b0) : L;
-          double gx[Dim][L], gu[Dim][L], gt[R][L], gv[L];
-          for (int q = 0; q < L; ++q) {
-            const BondIndex b = b0 + (q < n ? q : n - 1);
-            const int j = neighbor(b);
-            gv[q] = q < n && intact(b) ? vol(j) : 0.0;
-            for (int d = 0; d < Dim; ++d) {
-              gx[d][q] = x(j, d);
-              gu[d][q] = u(j, d);
-            }
-            for (int r = 0; r < R; ++r)
-              gt[r][q] = th(j, r);
-          }
+          for (int q = 0; q < L; ++q)
+            g.gather(q, b0, n, neighbor, intact, vol, x, u, th);
 #pragma GCC ivdep
           for (int q = 0; q < L; ++q) {
-            const double vj = gv[q];
-            double xi[Dim], uh[Dim], om[R], tb[R], c[Dim], len2 = 0;
-#pragma GCC unroll 16
-            for (int d = 0; d < Dim; ++d) {
-              xi[d] = gx[d][q] - xo[d];
-              len2 += xi[d] * xi[d];
-            }
-#pragma GCC unroll 16
-            for (int r = 0; r < R; ++r) {
-              tb[r] = 0.5 * (to[r] + gt[r][q]);
-              om[r] = gt[r][q] - to[r];
-            }
-            rot_cross<Dim>(tb, xi, c);
-#pragma GCC unroll 16
-            for (int d = 0; d < Dim; ++d)
-              uh[d] = gu[d][q] - uo[d] - c[d];
+            const double vj = g.v[q];
+            double xi[Dim], uh[Dim], om[R];
+            const double len2 = g.kinematics(q, xi, uh, om);
             const double il = 1.0 / std::sqrt(len2);
             const double g1 = c1 * il * il * il * vj, g2 = c2 * il * vj;
             double xv[Dim];
@@ -456,13 +483,9 @@ void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const Solid
       "mupm::Solid::pass2", range(0, pts.n_owned), KOKKOS_LAMBDA(const std::size_t i) {
         double f[Dim] = {}, l[R] = {}, wm = 0, f17[Dim + R] = {};
         // The owned point's rows, read once (the bond loop's stores could alias them).
-        double xo[Dim], uo[Dim], to[R], P1i[D2], Ei[D2], P2i[RD], Ki[RD], P1fi[D2] = {};
-        for (int d = 0; d < Dim; ++d) {
-          xo[d] = x(i, d);
-          uo[d] = u(i, d);
-        }
-        for (int r = 0; r < R; ++r)
-          to[r] = th(i, r);
+        BondLanes<Dim> g;
+        g.owner(x, u, th, i);
+        double P1i[D2], Ei[D2], P2i[RD], Ki[RD], P1fi[D2] = {};
         for (int k = 0; k < D2; ++k) {
           P1i[k] = P1(i, k);
           Ei[k] = eps(i, k);
@@ -479,19 +502,10 @@ void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const Solid
         for (BondIndex b0 = offsets(i); b0 < end; b0 += L) {
           const int n = end - b0 < L ? int(end - b0) : L;
           // Gather: lane q holds bond b0 + q (padding lanes repeat the last bond, weight 0).
-          double gx[Dim][L], gu[Dim][L], gt[R][L], gP1[D2][L], gE[D2][L], gP2[RD][L], gK[RD][L];
-          double gw[L], gv[L], gf[D2][L], gn[L];
+          double gP1[D2][L], gE[D2][L], gP2[RD][L], gK[RD][L], gw[L], gf[D2][L], gn[L];
           for (int q = 0; q < L; ++q) {
-            const BondIndex b = b0 + (q < n ? q : n - 1);
-            const int j = neighbor(b);
-            gv[q] = q < n && intact(b) ? vol(j) : 0.0;
+            const int j = g.gather(q, b0, n, neighbor, intact, vol, x, u, th);
             gw[q] = winv(j);
-            for (int d = 0; d < Dim; ++d) {
-              gx[d][q] = x(j, d);
-              gu[d][q] = u(j, d);
-            }
-            for (int r = 0; r < R; ++r)
-              gt[r][q] = th(j, r);
             for (int k = 0; k < D2; ++k) {
               gP1[k][q] = P1(j, k);
               gE[k][q] = eps(j, k);
@@ -510,22 +524,9 @@ void solid_pass2_variant(const Points<Dim>& pts, const Bonds& bonds, const Solid
           double lxi[Dim][L], lt[Dim][L], lm[R][L], lf[Dim][L], ll[R][L], l17[Dim + R][L];
 #pragma GCC ivdep
           for (int q = 0; q < L; ++q) {
-            const double vj = gv[q];
-            double xi[Dim], Uh[Dim], Om[R], tb[R], c[Dim], len2 = 0;
-#pragma GCC unroll 16
-            for (int d = 0; d < Dim; ++d) {
-              xi[d] = gx[d][q] - xo[d];
-              len2 += xi[d] * xi[d];
-            }
-#pragma GCC unroll 16
-            for (int r = 0; r < R; ++r) {
-              tb[r] = 0.5 * (to[r] + gt[r][q]);
-              Om[r] = gt[r][q] - to[r];
-            }
-            rot_cross<Dim>(tb, xi, c);
-#pragma GCC unroll 16
-            for (int d = 0; d < Dim; ++d)
-              Uh[d] = gu[d][q] - uo[d] - c[d];
+            const double vj = g.v[q];
+            double xi[Dim], Uh[Dim], Om[R];
+            const double len2 = g.kinematics(q, xi, Uh, Om);
             const double il = 1.0 / std::sqrt(len2);
             const double a1 = c1 * (il * il * il), a2 = c2 * il;  // eqs 66-70 with w0 = 1
             const double a1i = a1 * winv_i, a2i = a2 * winv_i, a1j = a1 * gw[q], a2j = a2 * gw[q];
