@@ -6,11 +6,14 @@
 
 #include <Teuchos_DefaultMpiComm.hpp>
 #include <Tpetra_Core.hpp>
+#include <cstdlib>
 #include <functional>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <tuple>
 
+#include "mupm/core/timers.hpp"
 #include "mupm/mesh/grid.hpp"
 
 namespace mupm::bench {
@@ -60,13 +63,21 @@ inline void set_counters(benchmark::State& state, double n_bonds, double n_point
 }
 
 // Runs the registered benchmarks between MPI/Kokkos initialization and finalization;
-// `release` drops any Views kept between benchmarks before Kokkos is finalized.
+// `release` drops any Views kept between benchmarks before Kokkos is finalized. With
+// MUPM_BENCH_TIMERS=1 the kernels' and regions' times over the whole run (set-up included, and
+// every repetition Google Benchmark makes) are printed to stderr at the end, as a run prints them.
 inline int run(int argc, char** argv, const std::function<void()>& release = {}) {
   Tpetra::ScopeGuard scope(&argc, &argv);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv))
     return 1;
+  const char* env = std::getenv("MUPM_BENCH_TIMERS");
+  const bool timed = env && std::string(env) == "1" && timers::enable();
   benchmark::RunSpecifiedBenchmarks();
+  if (timed) {
+    timers::report(MPI_COMM_SELF, std::cerr);
+    timers::disable();
+  }
   benchmark::Shutdown();
   if (release)
     release();

@@ -2,6 +2,7 @@
 
 #include <Teuchos_ArrayView.hpp>
 #include <Tpetra_Access.hpp>
+#include <algorithm>
 
 namespace mupm {
 
@@ -14,6 +15,25 @@ Distribution::Distribution(const Teuchos::RCP<const Comm>& comm, const std::vect
   all.insert(all.end(), ghosts.begin(), ghosts.end());
   overlap_map_ = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GlobalId>(all), 0, comm));
   importer_ = Teuchos::rcp(new Import(owned_map_, overlap_map_));
+  // The refresh's own plan: from the owned points some other rank holds as ghosts (the
+  // importer's export rows, each once) to the ghosts alone. The overlap import would also copy
+  // every owned row onto itself (its "same" rows): a refresh then costs the whole rank's rows
+  // even on one rank, where there is nothing to send.
+  std::vector<LocalId> sent(importer_->getExportLIDs().begin(), importer_->getExportLIDs().end());
+  std::sort(sent.begin(), sent.end());
+  sent.erase(std::unique(sent.begin(), sent.end()), sent.end());
+  std::vector<GlobalId> sent_gids(sent.size());
+  sent_lids_ = Kokkos::View<LocalId*>("mupm::sent_rows", sent.size());
+  auto lids = Kokkos::create_mirror_view(sent_lids_);
+  for (std::size_t k = 0; k < sent.size(); ++k) {
+    sent_gids[k] = owned[static_cast<std::size_t>(sent[k])];
+    lids(k) = sent[k];
+  }
+  Kokkos::deep_copy(sent_lids_, lids);
+  sent_map_ =
+      Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GlobalId>(sent_gids), 0, comm));
+  ghost_map_ = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GlobalId>(ghosts), 0, comm));
+  ghost_importer_ = Teuchos::rcp(new Import(sent_map_, ghost_map_));
 }
 
 Distribution::Buffers& Distribution::buffers(std::map<std::size_t, Buffers>& kept,
@@ -33,31 +53,36 @@ void Distribution::refresh(const std::vector<Vectors>& fields) {
     width += f.extent(1);
   if (width == 0)
     return;
-  const Buffers& bufs = buffers(refresh_bufs_, width);
-  const std::size_t n_own = n_owned_, n_gh = n_ghost_;
+  Buffers& bufs = refresh_bufs_[width];
+  if (bufs.owned.is_null()) {
+    bufs.owned = Teuchos::rcp(new MultiVector(sent_map_, width, false));
+    bufs.overlap = Teuchos::rcp(new MultiVector(ghost_map_, width, false));
+  }
+  const std::size_t n_own = n_owned_;
+  const auto lids = sent_lids_;
   {
     auto buf = bufs.owned->getLocalViewDevice(Tpetra::Access::OverwriteAll);
     std::size_t col = 0;
     for (const auto& f : fields) {
       const std::size_t nc = f.extent(1), c0 = col;
       Kokkos::parallel_for(
-          "mupm::Comm::pack", range(0, n_own), KOKKOS_LAMBDA(const std::size_t i) {
+          "mupm::Comm::pack", range(0, lids.extent(0)), KOKKOS_LAMBDA(const std::size_t k) {
             for (std::size_t c = 0; c < nc; ++c)
-              buf(i, c0 + c) = f(i, c);
+              buf(k, c0 + c) = f(lids(k), c);
           });
       col += nc;
     }
   }
-  bufs.overlap->doImport(*bufs.owned, *importer_, Tpetra::INSERT);
+  bufs.overlap->doImport(*bufs.owned, *ghost_importer_, Tpetra::INSERT);
   {
     auto buf = bufs.overlap->getLocalViewDevice(Tpetra::Access::ReadOnly);
     std::size_t col = 0;
     for (const auto& f : fields) {
       const std::size_t nc = f.extent(1), c0 = col;
       Kokkos::parallel_for(
-          "mupm::Comm::unpack", range(n_own, n_own + n_gh), KOKKOS_LAMBDA(const std::size_t i) {
+          "mupm::Comm::unpack", range(0, n_ghost_), KOKKOS_LAMBDA(const std::size_t g) {
             for (std::size_t c = 0; c < nc; ++c)
-              f(i, c) = buf(i, c0 + c);
+              f(n_own + g, c) = buf(g, c0 + c);
           });
       col += nc;
     }

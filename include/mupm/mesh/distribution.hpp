@@ -1,6 +1,7 @@
 // Distribution of points over MPI ranks with Tpetra: an owned map by global id, an overlap map
-// (owned first, then the ghosts within the horizon), one persistent Import, and a ghost refresh
-// that packs several per-point fields into one MultiVector (one message per neighbour rank).
+// (owned first, then the ghosts within the horizon), persistent Imports, and a ghost refresh
+// that packs several per-point fields into one MultiVector (one message per neighbour rank) and
+// moves only the rows other ranks hold as ghosts.
 #ifndef MUPM_DISTRIBUTION_HPP
 #define MUPM_DISTRIBUTION_HPP
 
@@ -50,8 +51,13 @@ class Distribution {
   Teuchos::RCP<const Comm> comm_;
   Teuchos::RCP<const Map> owned_map_, overlap_map_;
   Teuchos::RCP<const Import> importer_;
+  // The refresh's plan: the owned points other ranks hold as ghosts (sent_map_, their local rows
+  // sent_lids_) to this rank's ghosts (ghost_map_, in the overlap map's order).
+  Teuchos::RCP<const Map> sent_map_, ghost_map_;
+  Teuchos::RCP<const Import> ghost_importer_;
+  Kokkos::View<LocalId*> sent_lids_;
   std::size_t n_owned_ = 0, n_ghost_ = 0, refresh_count_ = 0;
-  // Pairs of (owned, overlap) buffers by width, kept for the run: a step refreshes fields of a
+  // Pairs of (source, target) buffers by width, kept for the run: a step refreshes fields of a
   // few widths in turn, and a buffer made anew for each would be allocated (and Tpetra's
   // communication buffers with it) several times a step.
   struct Buffers {

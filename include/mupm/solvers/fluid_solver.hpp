@@ -487,7 +487,7 @@ class FluidSolver : public Module {
   double stored_energy() const {
     const auto& p = disc_.points;
     auto pw = p.p, phi = p.porosity, vol = p.volume;
-    const VanGenuchten vg = prm_.retention;
+    const RetentionEnergy energy(prm_.retention);
     const double inv_kw = 1.0 / prm_.bulk_modulus;
     const double cz = prm_.pore.lateral_compliance;
     auto psi = psi_;
@@ -496,7 +496,7 @@ class FluidSolver : public Module {
     Kokkos::parallel_reduce(
         "mupm::Fluid::stored_energy", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i, double& acc) {
-          acc += vol(i) * (cached ? psi(i) : stored_energy_density(vg, phi(i), inv_kw, pw(i), cz));
+          acc += vol(i) * (cached ? psi(i) : energy.density(phi(i), inv_kw, pw(i), cz));
         },
         s);
     MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm_);
@@ -768,6 +768,7 @@ class FluidSolver : public Module {
     auto C = st_.storage, flow = st_.flow, src = source_;
     auto phi = p.porosity;
     const VanGenuchten vg = prm_.retention;
+    const RetentionEnergy energy(vg);
     const double inv_kw = 1.0 / prm_.bulk_modulus;
     const double biot = prm_.pore.biot, cz = prm_.pore.lateral_compliance;
     const double inv_total = 1.0 / dt_total;
@@ -820,11 +821,10 @@ class FluidSolver : public Module {
             // the step's mean pressure p0 + dp/2 when C is constant (header). psi(p0) is the
             // last update's psi(p1) (psi_, which stored_energy() sums).
             const double p1 = p0 + dp;
-            const double psi1 = stored_energy_density(vg, phi(i), inv_kw, p1, cz);
+            const double psi1 = energy.density(phi(i), inv_kw, p1, cz);
             const bool varies = storage_varies(vg, p0, p1);
             const double psi0 =
-                varies ? (cached ? psi(i) : stored_energy_density(vg, phi(i), inv_kw, p0, cz))
-                       : 0.0;
+                varies ? (cached ? psi(i) : energy.density(phi(i), inv_kw, p0, cz)) : 0.0;
             psi(i) = psi1;
             const double pe = entry_pressure(p0, dp, C(i), psi0, psi1, varies);
             wc += vol(i) * pe * biot * sr(i) * dv;

@@ -560,21 +560,26 @@ class SolidSolver : public Mechanics, public Skeleton {
     auto v = p.v, om = p.omega;
     auto vol = p.volume;
     auto fixed = p.fixed;
+    auto a = p.a, al = p.alpha;
     auto rho = rho_, J = inertia_;
-    double e[3] = {0, 0, acceleration_sum()};
+    double e[3] = {0, 0, 0};  // internal, kinetic, acceleration_sum() (one pass over the points)
     Kokkos::parallel_reduce(
         "mupm::Solid::energy", range(0, p.n_owned),
-        KOKKOS_LAMBDA(const std::size_t i, double& ei, double& ek) {
+        KOKKOS_LAMBDA(const std::size_t i, double& ei, double& ek, double& ea) {
           ei += en(i);
           const std::uint32_t fx = fixed(i);
           for (int k = 0; k < Dim; ++k)
-            if (!(fx & (1u << k)))
+            if (!(fx & (1u << k))) {
               ek += 0.5 * rho(i) * vol(i) * v(i, k) * v(i, k);
+              ea += rho(i) * vol(i) * a(i, k) * a(i, k);
+            }
           for (int r = 0; r < R; ++r)
-            if (!(fx & (1u << (Dim + r))))
+            if (!(fx & (1u << (Dim + r)))) {
               ek += 0.5 * J(i) * vol(i) * om(i, r) * om(i, r);
+              ea += J(i) * vol(i) * al(i, r) * al(i, r);
+            }
         },
-        e[0], e[1]);
+        e[0], e[1], e[2]);
     MPI_Allreduce(MPI_IN_PLACE, e, 3, MPI_DOUBLE, MPI_SUM, comm_);
     Energy out;
     out.internal = e[0];
