@@ -1,9 +1,14 @@
-// Distribution: the partition covers every point once, ghost values equal their owners', and
-// the bond list by global ids does not depend on the number of ranks.
+// Distribution: the partition covers every point once, ghost values equal their owners', the
+// bond list by global ids does not depend on the number of ranks, and exact sums over ranks
+// (core/exact_sum.hpp) do not depend on the order or split of their terms.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <random>
 
+#include "mupm/core/exact_sum.hpp"
 #include "mupm/core/timers.hpp"
 #include "mupm/kernels/boundary_conditions.hpp"
 #include "test_utils.hpp"
@@ -315,6 +320,85 @@ TEST(Distribution, PartitionCoversLattice) {
     for (int o : owner)
       ASSERT_GE(o, 0);
   }
+}
+
+// Terms of wide magnitudes and both signs, by index: column 0 cancels in pairs up to 1e12,
+// column 1 spans 1e-8 .. 1e8.
+double term(long long k, int c) {
+  const double s = std::sin(0.731 * double(k) + c);
+  if (c == 0)
+    return (k % 2 ? -1.0 : 1.0) * 1e12 * std::fabs(std::sin(0.731 * double(k / 2))) + s;
+  return s * std::pow(10.0, double(k % 17) - 8.0);
+}
+
+// The same terms split over the ranks (index modulo size) in a shuffled order, on one rank in
+// index order and in reverse: the three sums have the same bits.
+TEST(DistributionExactSum, SameBitsForAnyOrderAndSplit) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const long long n = 20001;
+  std::vector<long long> mine;
+  for (long long k = rank; k < n; k += size)
+    mine.push_back(k);
+  std::shuffle(mine.begin(), mine.end(), std::mt19937(17 + rank));
+  auto rows = [](const std::vector<long long>& ks) {
+    std::vector<double> t;
+    for (long long k : ks)
+      for (int c = 0; c < 2; ++c)
+        t.push_back(term(k, c));
+    return t;
+  };
+  const auto split = rows(mine);
+  const auto over_ranks = exact_sums(MPI_COMM_WORLD, split.data(), mine.size(), 2);
+  std::vector<long long> all(n);
+  for (long long k = 0; k < n; ++k)
+    all[std::size_t(k)] = k;
+  const auto forward = rows(all);
+  std::reverse(all.begin(), all.end());
+  const auto backward = rows(all);
+  const auto one = exact_sums(MPI_COMM_SELF, forward.data(), all.size(), 2);
+  const auto reversed = exact_sums(MPI_COMM_SELF, backward.data(), all.size(), 2);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_EQ(one[std::size_t(c)], reversed[std::size_t(c)]) << "column " << c;
+    EXPECT_EQ(one[std::size_t(c)], over_ranks[std::size_t(c)]) << "column " << c;
+  }
+  // Within the header's bound of the sum in long double: 2^(e - 65) a term, |terms| < 2^e.
+  for (int c = 0; c < 2; ++c) {
+    long double ref = 0, big = 0;
+    for (long long k = 0; k < n; ++k) {
+      ref += term(k, c);
+      big = std::max(big, std::fabs((long double)term(k, c)));
+    }
+    int e = 0;
+    std::frexp(double(big), &e);
+    const double bound = double(n) * std::ldexp(1.0, e - 65) + 4 * std::ldexp(1.0, e - 53) +
+                         std::fabs(double(ref)) * 1e-15;
+    EXPECT_NEAR(one[std::size_t(c)], double(ref), bound) << "column " << c;
+  }
+}
+
+// Terms on the sums' grid (integers and halves up to 2^29) add with no error at all: the sum
+// equals the integer sum computed here; and a column holding a NaN sums to NaN on every rank.
+TEST(DistributionExactSum, GridTermsAreExactAndNaNPropagates) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  std::int64_t twice = 0;  // twice the exact sum of column 0
+  std::vector<double> t;
+  std::size_t rows = 0;
+  for (long long k = 0; k < 4000; ++k) {
+    const std::int64_t v = ((k * 7919) % (1LL << 30)) - (1LL << 29);  // halves: v / 2
+    twice += v;
+    if (k % size != rank)
+      continue;
+    t.push_back(double(v) / 2);
+    t.push_back(k == 1234 ? NAN : 1.0);
+    ++rows;
+  }
+  const auto s = exact_sums(MPI_COMM_WORLD, t.data(), rows, 2);
+  EXPECT_EQ(s[0], double(twice) / 2);
+  EXPECT_TRUE(std::isnan(s[1]));
 }
 
 }  // namespace

@@ -19,21 +19,21 @@
 // it the crack runs at Delta a / dt (above the wave speeds) for as long as the contours, whose
 // edges the field of the last increment has not reached yet, still show J >= G_cr.
 //
-// Sums over ranks: every point's terms are gathered with its global id and added in id order,
-// so that J, and with it the criterion's decision, is the same to the last bit on any number of
-// ranks and threads.
+// Sums over ranks: every point's terms are added exactly (include/mupm/core/exact_sum.hpp), so
+// that J, and with it the criterion's decision, is the same to the last bit on any number of
+// ranks and threads, with messages whose size does not depend on the resolution.
 #ifndef MUPM_SOLVERS_J_INTEGRAL_HPP
 #define MUPM_SOLVERS_J_INTEGRAL_HPP
 
 #include <mpi.h>
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "mupm/core/exact_sum.hpp"
 #include "mupm/kernels/fracture.hpp"
 #include "mupm/kernels/j_integral.hpp"
 #include "mupm/solvers/damage.hpp"
@@ -135,50 +135,23 @@ class JIntegral : public Module {
       const auto& p = disc_.points;
       j_integral_terms(p, disc_.bonds, sp_, *st_, jc, terms_);
       auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), terms_);
-      auto gid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.gid);
-      // Rows of the points with a term: global id, then 3 nc terms.
-      const int w = 1 + 3 * nc;
+      // Per point with a term, for each contour: the translational part (its first two terms
+      // added) and the rotational part; summed over ranks exactly (core/exact_sum.hpp).
       std::vector<double> mine;
+      std::size_t rows = 0;
       for (std::size_t i = 0; i < p.n_owned; ++i) {
         bool any = false;
         for (int k = 0; k < 3 * nc; ++k)
           any = any || h(i, k) != 0;
         if (!any)
           continue;
-        mine.push_back(double(gid(i)));
-        for (int k = 0; k < 3 * nc; ++k)
-          mine.push_back(h(i, k));
+        ++rows;
+        for (int c = 0; c < nc; ++c) {
+          mine.push_back(h(i, 3 * c) + h(i, 3 * c + 1));
+          mine.push_back(h(i, 3 * c + 2));
+        }
       }
-      // Rank 0 sums the rows in global-id order (the same bits on any number of ranks) and
-      // sends the sums: no rank but 0 receives more than the 2 nc sums.
-      int size = 0, rank = 0, n = int(mine.size());
-      MPI_Comm_size(comm_, &size);
-      MPI_Comm_rank(comm_, &rank);
-      std::vector<int> counts(rank == 0 ? std::size_t(size) : 0), displs(counts.size(), 0);
-      MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
-      std::vector<double> all, sums(2 * std::size_t(nc), 0.0);
-      if (rank == 0) {
-        for (int r = 1; r < size; ++r)
-          displs[std::size_t(r)] = displs[std::size_t(r - 1)] + counts[std::size_t(r - 1)];
-        all.resize(std::size_t(displs.back() + counts.back()));
-      }
-      MPI_Gatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
-                  0, comm_);
-      if (rank == 0) {
-        std::vector<std::size_t> rows(all.size() / std::size_t(w));
-        for (std::size_t r = 0; r < rows.size(); ++r)
-          rows[r] = r;
-        std::sort(rows.begin(), rows.end(), [&](std::size_t a, std::size_t b) {
-          return all[a * std::size_t(w)] < all[b * std::size_t(w)];
-        });
-        for (std::size_t r : rows)
-          for (std::size_t c = 0; c < std::size_t(nc); ++c) {
-            const double* t = &all[r * std::size_t(w) + 1 + 3 * c];
-            sums[2 * c] += t[0] + t[1];
-            sums[2 * c + 1] += t[2];
-          }
-      }
-      MPI_Bcast(sums.data(), 2 * nc, MPI_DOUBLE, 0, comm_);
+      const std::vector<double> sums = exact_sums(comm_, mine.data(), rows, 2 * nc);
       for (std::size_t c = 0; c < std::size_t(nc); ++c) {
         out[c].translational = sums[2 * c];
         out[c].rotational = sums[2 * c + 1];
