@@ -319,8 +319,6 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
       if (auto* j = ph.j_integral.get()) {
         j->attach(solid->state(), solid->params());
         solid->keep_pore_part();
-        if (model.j_integral.criterion)
-          solid->set_crack_driver([j](double t) { return j->advance(t); });
       }
       ph.mechanics = std::move(solid);
     };
@@ -351,6 +349,8 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   ph.sequence.mechanics = ph.mechanics.get();
   ph.sequence.fluid = ph.fluid.get();
   ph.sequence.damage = ph.damage.get();
+  if (model.j_integral.criterion && has_solid(physics))  // J integrates the solid's state
+    ph.sequence.j_criterion = ph.j_integral.get();
   ph.sequence.fluid_first = model.run.staggering == Staggering::FluidFirst;
   ph.sequence.fluid_every = ph.mechanics ? model.run.solid_steps_per_fluid_step : 1;
   return ph;

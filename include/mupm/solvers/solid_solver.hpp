@@ -9,8 +9,8 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
-#include <functional>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -184,10 +184,6 @@ class SolidSolver : public Mechanics, public Skeleton {
   // energy criterion only.
   bool breaks() const { return set_.fracture.criterion != BondBreaking::None; }
   bool energy_criterion() const { return set_.fracture.criterion == BondBreaking::Energy; }
-  // What breaks bonds besides the energy criterion (the J criterion, include/mupm/solvers/
-  // j_integral.hpp): called with the step's end time after its forces, before the velocity
-  // update; collective; returns the directed bonds it broke on this rank.
-  void set_crack_driver(std::function<Breakage(double)> driver) { driver_ = std::move(driver); }
   // The pore-water part of the force state kept apart (SolidState::P1w) for the J-integral's
   // effective force state too, without breakage (before initialize).
   void keep_pore_part() { keep_pore_part_ = true; }
@@ -351,6 +347,18 @@ class SolidSolver : public Mechanics, public Skeleton {
     move(t, dt);
     finish(t, dt);
   }
+  // The same step in two parts, around a crack criterion that breaks bonds on the forces at
+  // t + dt (StepSequence: the J criterion).
+  void step_to_forces(double t, double dt) override {
+    dt_ = dt;
+    move(t, dt);
+    finish_forces(t, dt);
+  }
+  void complete_step(double t, double dt, long long broken) override { complete(t, dt, broken); }
+  void finish(double t, double dt) {
+    finish_forces(t, dt);
+    complete(t, dt, 0);
+  }
   // The step's first half: the velocities' first half and the positions at t + dt, prescribed
   // components at their values. The semi-implicit pressure corrects the free components here
   // (include/mupm/solvers/pressure_projection.hpp).
@@ -370,8 +378,9 @@ class SolidSolver : public Mechanics, public Skeleton {
     projection_work_ += w;
   }
   double projection_work() const { return projection_work_; }
-  // The rest of the step: boundary layers, forces at t + dt, work, breakage, velocities.
-  void finish(double t, double dt) override {
+  // The rest of the step, in two parts. finish_forces: boundary layers, forces at t + dt, the
+  // step's work and the energy criterion's breakage (this rank's terms, kept in pending_).
+  void finish_forces(double t, double dt) override {
     ScopedRegion region("mupm::Solid::step");
     auto& p = disc_.points;
     if (slaved_)  // 2 dg of each slaved condition (twice_dg_)
@@ -391,11 +400,12 @@ class SolidSolver : public Mechanics, public Skeleton {
       for (std::size_t k = 0; k < bcs_.size(); ++k)
         if (bcs_[k].kinematic() && bcs_[k].slaved)
           slaved_increment(bcs_[k], p, du_, twice_dg_[k]);
-    // Work, dissipation, pore work and bond breakage of the step (this rank's points), then one
-    // reduction.
+    // Work, dissipation, pore work and bond breakage of the step (this rank's points), reduced
+    // in complete().
     // w[0]: the external work, w[6]: the crack force's share of it, both by the trapezoid rule
     // on the forces at the step's start and end.
-    double w[7] = {};
+    double* w = pending_;
+    std::fill(w, w + 7, 0.0);
     auto trapezoid_half = [&] {
       double half[2];
       power(half);
@@ -419,8 +429,15 @@ class SolidSolver : public Mechanics, public Skeleton {
       w[3] = double(br.bonds);
       w[4] = br.energy;
     }
-    if (driver_)
-      w[3] += double(driver_(t + dt).bonds);
+  }
+  // complete: with `broken` the directed bonds a crack criterion broke on this rank since
+  // finish_forces (collective): the step's one reduction, the velocities at t + dt, then the
+  // forces of the new bond set.
+  void complete(double t, double dt, long long broken) override {
+    ScopedRegion region("mupm::Solid::step");
+    auto& p = disc_.points;
+    double* w = pending_;
+    w[3] += double(broken);
     MPI_Allreduce(MPI_IN_PLACE, w, 7, MPI_DOUBLE, MPI_SUM, comm_);
     work_ += w[0];
     crack_work_ += w[6];
@@ -1140,10 +1157,13 @@ class SolidSolver : public Mechanics, public Skeleton {
   // The displacement a slaved Velocity condition has prescribed since t = 0 (by condition; a
   // restart global), the g its layer reflects about.
   std::vector<double> slaved_disp_;
-  std::vector<double> twice_dg_;            // 2 dg of each slaved condition in the current step
-  bool pressure_ = false;                   // breakage run with pore pressure (initialize)
-  bool keep_pore_part_ = false;             // P1w for the J-integral (keep_pore_part)
-  std::function<Breakage(double)> driver_;  // the J criterion (set_crack_driver), at time t
+  std::vector<double> twice_dg_;  // 2 dg of each slaved condition in the current step
+  bool pressure_ = false;         // breakage run with pore pressure (initialize)
+  bool keep_pore_part_ = false;   // P1w for the J-integral (keep_pore_part)
+  // This rank's terms of the step between finish_forces and complete: external work,
+  // dissipation, pore work, directed bonds broken, their energy, stored energy before breakage,
+  // the crack force's work.
+  double pending_[7] = {};
   Scratch scratch_;  // the fields estimate_stable_dt and keeping_plastic_state save
 };
 

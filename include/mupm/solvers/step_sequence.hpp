@@ -9,11 +9,15 @@
 //   Fluid First: at the start of an interval the fluid advances with the volume change of the
 //     previous interval; then the solid steps with the new p.
 // After each fluid update the mixture density follows the new saturation (eq 1).
+// The J criterion (include/mupm/solvers/j_integral.hpp, Algorithm 3) is a step of its own
+// between the mechanics' forces at t + dt and its velocity update: the bonds it breaks count in
+// the step's breakage, whose damage and flow follow in after_mechanics().
 #ifndef MUPM_STEP_SEQUENCE_HPP
 #define MUPM_STEP_SEQUENCE_HPP
 
 #include "mupm/solvers/damage.hpp"
 #include "mupm/solvers/fluid_solver.hpp"
+#include "mupm/solvers/j_integral.hpp"
 #include "mupm/solvers/module.hpp"
 
 namespace mupm {
@@ -32,13 +36,16 @@ struct StepSequence {
   // solve (include/mupm/solvers/pressure_projection.hpp): move, pressure, finish, breakage and
   // damage, then the fluid's water and energy bookkeeping; every step, no substeps.
   Skeleton* skeleton = nullptr;
+  // Fracture->Bond Breakage = J-Integral: Algorithm 3 after the mechanics' forces (header).
+  JIntegral<Dim>* j_criterion = nullptr;
 
   // Step number `step` (0-based, counted from t = 0 so restarts keep the intervals), t -> t + dt.
   void step(long long step, double t, double dt) {
     if (skeleton && fluid && fluid->semi_implicit()) {
       skeleton->move(t, dt);
       fluid->project(t, dt, *skeleton);
-      skeleton->finish(t, dt);
+      skeleton->finish_forces(t, dt);
+      skeleton->complete(t, dt, crack_criterion(t + dt));
       after_mechanics();
       fluid->finish_projection(dt);
       mechanics->update_density();
@@ -47,8 +54,12 @@ struct StepSequence {
     const double interval = fluid_every * dt;
     if (fluid && fluid_first && step % fluid_every == 0)
       advance_fluid(t, interval);
-    if (mechanics)
+    if (mechanics && j_criterion) {
+      mechanics->step_to_forces(t, dt);
+      mechanics->complete_step(t, dt, crack_criterion(t + dt));
+    } else if (mechanics) {
       mechanics->step(t, dt);
+    }
     after_mechanics();
     // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
     if (fluid && !fluid_first && (step + 1) % fluid_every == 0)
@@ -56,6 +67,10 @@ struct StepSequence {
   }
 
  private:
+  // The J criterion at the step's end time: the directed bonds it broke on this rank.
+  long long crack_criterion(double t_end) {
+    return j_criterion ? j_criterion->advance(t_end).bonds : 0;
+  }
   void after_mechanics() {
     // Bonds broke in the mechanics step: the damage changes (the pre-cracks' is computed at
     // the start), and so does the fluid's flow of the current pressure (K^-1 and the families).
