@@ -202,8 +202,8 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
     for (const auto& f : fixed)
       file.write_attribute(fixed_attribute(f), f.value);
     file.write_global("output_history", output_history);
-    for (const auto& [name, value] : globals)
-      file.write_global("globals/" + name, {*value});
+    for (const auto& g : globals)
+      file.write_global("globals/" + g.name, {g.get()});
     for_each_checkpointed(disc.points, [&](const auto& view, const FieldSpec& s) {
       const auto rows = io::owned_rows(view, n);
       file.write_points(std::string("points/") + s.name, gids, n_global, s.ncomp, rows.data());
@@ -239,12 +239,16 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
   step = file.read_attribute_int("step");
   time = file.read_attribute_double("time");
   output_history = file.read_global("output_history");
-  for (const auto& [name, value] : globals) {
-    if (!file.has_dataset("globals/" + name))
-      throw CollectiveError(where + "holds no restart value '" + name +
+  for (const auto& g : globals) {
+    if (!file.has_dataset("globals/" + g.name))
+      throw CollectiveError(where + "holds no restart value '" + g.name +
                             "': it was written by a run with other physics or other boundary "
                             "conditions than this input's.");
-    *value = file.read_global("globals/" + name).at(0);
+    try {
+      g.set(file.read_global("globals/" + g.name).at(0));
+    } catch (const std::domain_error& e) {  // the same value, so the same error, on every rank
+      throw CollectiveError(where + "is damaged: " + e.what() + ".");
+    }
   }
   for_each_checkpointed(disc.points, [&](const auto& view, const FieldSpec& s) {
     std::vector<typename std::decay_t<decltype(view)>::value_type> rows(n * std::size_t(s.ncomp));

@@ -247,10 +247,10 @@ struct Assembly {
   // The stable-step watch's state (StableStepWatch), kept across a restart so that a restarted
   // run re-estimates at the same steps and keeps the fluid substeps of the straight run.
   struct Watch {
-    double pairs_at = 0;    // broken pairs at the last estimate
-    double storage_at = 0;  // smallest storage C at the last estimate [1/Pa]
-    double substeps = 0;    // fluid substeps in use (0: not set yet)
-    double time_step = 0;   // the run's dt [s] (choose_time_step; 0: not set yet)
+    long long pairs_at = 0;  // broken pairs at the last estimate
+    double storage_at = 0;   // smallest storage C at the last estimate [1/Pa]
+    long long substeps = 0;  // fluid substeps in use (0: not set yet)
+    double time_step = 0;    // the run's dt [s] (choose_time_step; 0: not set yet)
   } watch;
   // Time series, restart globals and energy balances, in the time series' column order.
   std::vector<Module*> modules() const {
@@ -279,12 +279,14 @@ struct Assembly {
     for (Module* m : modules()) {
       GlobalRefs g;
       m->globals(g);
-      for (const auto& [name, ptr] : g.refs())
-        out.push_back({std::string(m->name()) + "/" + name, ptr});
+      for (GlobalRef r : g.refs()) {
+        r.name = std::string(m->name()) + "/" + r.name;
+        out.push_back(r);
+      }
     }
-    out.push_back({"stable_steps/broken_pairs_at_estimate", &watch.pairs_at});
+    out.push_back({"stable_steps/broken_pairs_at_estimate", nullptr, &watch.pairs_at});
     out.push_back({"stable_steps/min_storage_at_estimate", &watch.storage_at});
-    out.push_back({"stable_steps/fluid_substeps", &watch.substeps});
+    out.push_back({"stable_steps/fluid_substeps", nullptr, &watch.substeps});
     out.push_back({"stable_steps/time_step", &watch.time_step});
     return out;
   }
@@ -580,7 +582,7 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
     }
     // A restart continues with the substeps the run had reached (StableStepWatch).
     if (restarted && ph.watch.substeps > 0)
-      substeps = int(ph.watch.substeps);
+      substeps = static_cast<int>(ph.watch.substeps);
     ph.sequence.substeps = substeps;
     ph.watch.substeps = substeps;
     const double dt_f = interval / substeps;
@@ -627,7 +629,7 @@ class StableStepWatch {
 
   void operator()(long long step, double time) {
     const bool broke =
-        solid_ && double(solid_->broken_pairs()) - ph_.watch.pairs_at >= 0.01 * pairs_;
+        solid_ && double(solid_->broken_pairs() - ph_.watch.pairs_at) >= 0.01 * pairs_;
     const bool wetted = ph_.fluid && !ph_.fluid->semi_implicit() &&
                         ph_.fluid->min_storage() < 0.5 * ph_.watch.storage_at;
     if (!broke && !wetted)
@@ -679,7 +681,7 @@ class StableStepWatch {
 
  private:
   void remember() {
-    ph_.watch.pairs_at = solid_ ? double(solid_->broken_pairs()) : 0.0;
+    ph_.watch.pairs_at = solid_ ? solid_->broken_pairs() : 0;
     ph_.watch.storage_at = ph_.fluid ? ph_.fluid->min_storage() : 0.0;
   }
   const RunSettings& run_;

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "mupm/core/global_ref.hpp"
 #include "mupm/mesh/discretization.hpp"
 
 namespace mupm {
@@ -20,7 +21,7 @@ namespace mupm {
 inline constexpr long long kCheckpointVersion = 3;
 
 // Named scalars, each pointing at its owner's value (written from it, read into it).
-using NamedGlobals = std::vector<std::pair<std::string, double*>>;
+using NamedGlobals = std::vector<GlobalRef>;
 
 // A setting the checkpoint's state was made under and a restart cannot change: its input path
 // (e.g. "Materials->Model"), its value as text, and why the state cannot follow a change. Written

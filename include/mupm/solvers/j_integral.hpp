@@ -85,7 +85,7 @@ class JIntegral : public Module {
       row("j_integral_" + std::to_string(k + 1), v[k].total);
     if (prm_.criterion) {  // the crack the criterion grew: the pre-crack in the body + n da
       const Crack& c = disc_.grid.cracks.front();
-      row("j_crack_length", damage_.inside_length(c) + advances_ * prm_.increment);
+      row("j_crack_length", damage_.inside_length(c) + double(advances_) * prm_.increment);
     }
   }
 
@@ -93,8 +93,8 @@ class JIntegral : public Module {
   std::array<double, 2> tip() const {
     const Crack& c = disc_.grid.cracks.front();
     if (prm_.criterion)
-      return {c.b[0] + advances_ * prm_.increment * d_[0],
-              c.b[1] + advances_ * prm_.increment * d_[1]};
+      return {c.b[0] + double(advances_) * prm_.increment * d_[0],
+              c.b[1] + double(advances_) * prm_.increment * d_[1]};
     const auto t = damage_.crack_tip();
     return {t.x[0], t.x[1]};
   }
@@ -186,7 +186,7 @@ class JIntegral : public Module {
     advances_ += 1;
     return br;
   }
-  double advances() const { return advances_; }
+  long long advances() const { return advances_; }
 
  private:
   Discretization<Dim>& disc_;
@@ -197,7 +197,7 @@ class JIntegral : public Module {
   SolidParams sp_;
   Vectors terms_;
   double d_[2] = {1, 0};
-  double advances_ = 0;      // increments the crack advanced (J criterion; a restart global)
+  long long advances_ = 0;   // increments the crack advanced (J criterion; a restart global)
   double last_advance_ = 0;  // time of the last advance (J criterion; a restart global)
 };
 

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "mupm/core/global_ref.hpp"
 #include "mupm/core/types.hpp"
 
 namespace mupm {
@@ -30,15 +31,18 @@ class SeriesRow {
   std::vector<double> values_;
 };
 
-// The named scalars a module keeps across a restart (cumulative work, inflows...): the
+// The named scalars a module keeps across a restart (cumulative work, inflows, counts...): the
 // checkpoint stores each as globals/<module>/<name> and a restart puts it back by name.
 class GlobalRefs {
  public:
   void operator()(const std::string& name, double& value) { refs_.push_back({name, &value}); }
-  const std::vector<std::pair<std::string, double*>>& refs() const { return refs_; }
+  void operator()(const std::string& name, long long& value) {
+    refs_.push_back({name, nullptr, &value});
+  }
+  const std::vector<GlobalRef>& refs() const { return refs_; }
 
  private:
-  std::vector<std::pair<std::string, double*>> refs_;
+  std::vector<GlobalRef> refs_;
 };
 
 // One energy balance: |error| should stay below Solver->Energy Tolerance x scale. A stored

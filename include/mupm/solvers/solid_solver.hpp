@@ -448,13 +448,13 @@ class SolidSolver : public Mechanics, public Skeleton {
                        set_.damping, dt);
     if (w[3] > 0) {
       after_breakage(t + dt, w[5]);
-      broken_pairs_ += w[3] / 2;
+      broken_pairs_ += static_cast<long long>(w[3]) / 2;  // each pair twice over the ranks
     }
     if constexpr (Law::plastic)  // with the stress of the step's end, after any breakage
       plastic_dissipation_ += plastic_power();
     steps_ += 1;
     const int window = set_.second_order_window;
-    if (window > 0 && std::fmod(steps_, double(window)) == 0) {
+    if (window > 0 && steps_ % window == 0) {
       second_order_work(p, st_.eps, st_.kappa, p.second_order_work_start, p.second_order_work);
       double v[2];
       negative_volume(p, p.second_order_work, v[0], v[1]);
@@ -462,7 +462,7 @@ class SolidSolver : public Mechanics, public Skeleton {
       negative_fraction_ = v[0] > 0 ? v[1] / v[0] : 0.0;
     }
   }
-  long long broken_pairs() const override { return (long long)broken_pairs_; }
+  long long broken_pairs() const override { return broken_pairs_; }
 
   // Bonds broke at the end of a step (Algorithm 4), after its velocity update: the step ran
   // with the old bond set, as its work and the bond energies were booked. K, its inverse and
@@ -1146,10 +1146,10 @@ class SolidSolver : public Mechanics, public Skeleton {
   double crack_work_ = 0;       // work of the crack water's face forces since t = 0 [J] (Energy)
   double fracture_energy_ = 0;  // strain energy lost to bond breakage since t = 0 [J]
   double plastic_dissipation_ = 0;   // plastic dissipation since t = 0 [J] (plastic law)
-  double steps_ = 0;                 // steps since t = 0 (second-order work windows)
+  long long steps_ = 0;              // steps since t = 0 (second-order work windows)
   double negative_fraction_ = 0;     // volume fraction with d2E < 0, last window
   double bond_energy_released_ = 0;  // W V_i V_j of the bonds broken since t = 0 [J]
-  double broken_pairs_ = 0;          // bond pairs broken since t = 0 (a restart global)
+  long long broken_pairs_ = 0;       // bond pairs broken since t = 0 (a restart global)
   bool mirrored_ = false;            // mirrored Displacement conditions (mirror_layers)
   bool slaved_ = false;              // slaved layers (slave_layer, fold_layers)
   Vectors fold_;                     // fold_layers' buffer [owned + ghosts][columns]
