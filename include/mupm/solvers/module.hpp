@@ -12,6 +12,7 @@
 
 #include "mupm/core/global_ref.hpp"
 #include "mupm/core/types.hpp"
+#include "mupm/kernels/fracture.hpp"
 
 namespace mupm {
 
@@ -90,12 +91,14 @@ class Mechanics : public Module {
   // holds them) also the accelerations.
   virtual void initialize(double t, bool restarted) = 0;
   virtual void step(double t, double dt) = 0;
-  // The same step in two parts, around a crack criterion that breaks bonds on the forces at
-  // t + dt (StepSequence: the J criterion): step_to_forces up to those forces and the step's
-  // work, complete_step with the directed bonds the criterion broke on this rank (collective).
-  // Without forces (kinematics alone) the whole step is the first part.
+  // The same step in parts, with the bond breakage on the forces at t + dt between them
+  // (StepSequence): step_to_forces up to those forces and the step's work; energy_breakage, the
+  // energy criterion (Algorithm 4) on the step's bond energies; complete_step with all the bonds
+  // broken on this rank (by the energy and J criteria; collective). Without forces (kinematics
+  // alone) the whole step is the first part and nothing breaks.
   virtual void step_to_forces(double t, double dt) { step(t, dt); }
-  virtual void complete_step(double /*t*/, double /*dt*/, long long /*broken*/) {}
+  virtual Breakage energy_breakage() { return {}; }
+  virtual void complete_step(double /*t*/, double /*dt*/, const Breakage& /*broken*/) {}
   // The run's step, once chosen (after initialize): energies that depend on it.
   virtual void set_time_step(double /*dt*/) {}
   // Whether the scheme has a stability limit, and the largest stable step (collective).
@@ -127,10 +130,10 @@ class Skeleton {
  public:
   virtual ~Skeleton() = default;
   virtual void move(double t, double dt) = 0;
-  // The rest of the step after the pressure correction, in the two parts of
-  // Mechanics::step_to_forces / complete_step (the J criterion between them).
+  // The rest of the step after the pressure correction, in the parts of
+  // Mechanics::step_to_forces / complete_step (the bond breakage between them).
   virtual void finish_forces(double t, double dt) = 0;
-  virtual void complete(double t, double dt, long long broken) = 0;
+  virtual void complete(double t, double dt, const Breakage& broken) = 0;
   virtual SkeletonState skeleton_state() const = 0;
   // The correction's work on the skeleton [J] (summed over ranks), for the energy ledger.
   virtual void add_projection_work(double w) = 0;

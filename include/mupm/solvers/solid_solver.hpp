@@ -347,17 +347,18 @@ class SolidSolver : public Mechanics, public Skeleton {
     move(t, dt);
     finish(t, dt);
   }
-  // The same step in two parts, around a crack criterion that breaks bonds on the forces at
-  // t + dt (StepSequence: the J criterion).
+  // The same step in parts, the bond breakage between them (Mechanics; StepSequence).
   void step_to_forces(double t, double dt) override {
     dt_ = dt;
     move(t, dt);
     finish_forces(t, dt);
   }
-  void complete_step(double t, double dt, long long broken) override { complete(t, dt, broken); }
+  void complete_step(double t, double dt, const Breakage& broken) override {
+    complete(t, dt, broken);
+  }
   void finish(double t, double dt) {
     finish_forces(t, dt);
-    complete(t, dt, 0);
+    complete(t, dt, energy_breakage());
   }
   // The step's first half: the velocities' first half and the positions at t + dt, prescribed
   // components at their values. The semi-implicit pressure corrects the free components here
@@ -378,8 +379,8 @@ class SolidSolver : public Mechanics, public Skeleton {
     projection_work_ += w;
   }
   double projection_work() const { return projection_work_; }
-  // The rest of the step, in two parts. finish_forces: boundary layers, forces at t + dt, the
-  // step's work and the energy criterion's breakage (this rank's terms, kept in pending_).
+  // The rest of the step, in parts. finish_forces: boundary layers, forces at t + dt and the
+  // step's work (this rank's terms, kept in pending_ for complete()).
   void finish_forces(double t, double dt) override {
     ScopedRegion region("mupm::Solid::step");
     auto& p = disc_.points;
@@ -400,17 +401,15 @@ class SolidSolver : public Mechanics, public Skeleton {
       for (std::size_t k = 0; k < bcs_.size(); ++k)
         if (bcs_[k].kinematic() && bcs_[k].slaved)
           slaved_increment(bcs_[k], p, du_, twice_dg_[k]);
-    // Work, dissipation, pore work and bond breakage of the step (this rank's points), reduced
-    // in complete().
-    // w[0]: the external work, w[6]: the crack force's share of it, both by the trapezoid rule
-    // on the forces at the step's start and end.
-    double* w = pending_;
-    std::fill(w, w + 7, 0.0);
+    // External work and the crack force's share of it by the trapezoid rule on the forces at
+    // the step's start and end, dissipation and pore work (this rank's points).
+    StepTerms& w = pending_;
+    w = StepTerms{};
     auto trapezoid_half = [&] {
       double half[2];
       power(half);
-      w[0] += 0.5 * half[0];
-      w[6] += 0.5 * half[1];
+      w.external_work += 0.5 * half[0];
+      w.crack_work += 0.5 * half[1];
     };
     trapezoid_half();
     Kokkos::deep_copy(vs_old_,
@@ -418,37 +417,42 @@ class SolidSolver : public Mechanics, public Skeleton {
     st_.work = energy_criterion() ? BondWork::Accumulate : BondWork::Off;
     forces(t + dt);
     trapezoid_half();
-    w[1] = dt * damping_power();
-    w[2] = pore_power() + eq17_power();
+    w.dissipation = dt * damping_power();
+    w.pore_work = pore_power() + eq17_power();
     keep_applied();
     if (breaks())
-      w[5] = stored_energy();
-    if (energy_criterion()) {
-      const Breakage br = break_bonds(p, disc_.bonds, set_.fracture.critical_energy, st_.max_energy,
-                                      p.bond_energy_released);
-      w[3] = double(br.bonds);
-      w[4] = br.energy;
-    }
+      w.stored_before = stored_energy();
   }
-  // complete: with `broken` the directed bonds a crack criterion broke on this rank since
-  // finish_forces (collective): the step's one reduction, the velocities at t + dt, then the
-  // forces of the new bond set.
-  void complete(double t, double dt, long long broken) override {
+  // The energy criterion (Algorithm 4) on the bond energies of the forces at t + dt: the bonds
+  // it broke on this rank and the energy they released.
+  Breakage energy_breakage() override {
+    if (!energy_criterion())
+      return {};
+    auto& p = disc_.points;
+    return break_bonds(p, disc_.bonds, set_.fracture.critical_energy, st_.max_energy,
+                       p.bond_energy_released);
+  }
+  // complete: with `broken` the directed bonds broken on this rank since finish_forces (by the
+  // energy and J criteria) and their energy (collective): the step's one reduction, the
+  // velocities at t + dt, then the forces of the new bond set.
+  void complete(double t, double dt, const Breakage& broken) override {
     ScopedRegion region("mupm::Solid::step");
     auto& p = disc_.points;
-    double* w = pending_;
-    w[3] += double(broken);
-    MPI_Allreduce(MPI_IN_PLACE, w, 7, MPI_DOUBLE, MPI_SUM, comm_);
-    work_ += w[0];
-    crack_work_ += w[6];
-    dissipation_ += w[1];
-    pore_work_ += w[2];
-    bond_energy_released_ += w[4];
+    StepTerms& w = pending_;
+    w.broken = double(broken.bonds);
+    w.released = broken.energy;
+    static_assert(sizeof(StepTerms) == 7 * sizeof(double));
+    MPI_Allreduce(MPI_IN_PLACE, &w, 7, MPI_DOUBLE, MPI_SUM, comm_);
+    work_ += w.external_work;
+    crack_work_ += w.crack_work;
+    dissipation_ += w.dissipation;
+    pore_work_ += w.pore_work;
+    bond_energy_released_ += w.released;
     advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                        set_.damping, dt);
-    if (w[3] > 0) {
-      after_breakage(t + dt, w[5]);
-      broken_pairs_ += static_cast<long long>(w[3]) / 2;  // each pair twice over the ranks
+    if (w.broken > 0) {
+      after_breakage(t + dt, w.stored_before);
+      broken_pairs_ += static_cast<long long>(w.broken) / 2;  // each pair twice over the ranks
     }
     if constexpr (Law::plastic)  // with the stress of the step's end, after any breakage
       plastic_dissipation_ += plastic_power();
@@ -1160,10 +1164,16 @@ class SolidSolver : public Mechanics, public Skeleton {
   std::vector<double> twice_dg_;  // 2 dg of each slaved condition in the current step
   bool pressure_ = false;         // breakage run with pore pressure (initialize)
   bool keep_pore_part_ = false;   // P1w for the J-integral (keep_pore_part)
-  // This rank's terms of the step between finish_forces and complete: external work,
-  // dissipation, pore work, directed bonds broken, their energy, stored energy before breakage,
-  // the crack force's work.
-  double pending_[7] = {};
+  // This rank's terms of a step, from finish_forces to complete's one reduction.
+  struct StepTerms {
+    double external_work = 0;  // [J] (the trapezoid rule, power())
+    double crack_work = 0;     // [J] the crack water force's share of external_work
+    double dissipation = 0;    // [J] damping
+    double pore_work = 0;      // [J] pore pressure and eq 17's water force
+    double stored_before = 0;  // [J] strain energy before the breakage (after_breakage)
+    double broken = 0;         // directed bonds broken (energy and J criteria)
+    double released = 0;       // [J] the bond energy they released (energy criterion)
+  } pending_;
   Scratch scratch_;  // the fields estimate_stable_dt and keeping_plastic_state save
 };
 

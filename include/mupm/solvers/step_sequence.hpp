@@ -9,9 +9,10 @@
 //   Fluid First: at the start of an interval the fluid advances with the volume change of the
 //     previous interval; then the solid steps with the new p.
 // After each fluid update the mixture density follows the new saturation (eq 1).
-// The J criterion (include/mupm/solvers/j_integral.hpp, Algorithm 3) is a step of its own
-// between the mechanics' forces at t + dt and its velocity update: the bonds it breaks count in
-// the step's breakage, whose damage and flow follow in after_mechanics().
+// Bond breakage is a step of its own between the mechanics' forces at t + dt and its velocity
+// update: the energy criterion (Algorithm 4) on the step's bond energies, then the J criterion
+// (include/mupm/solvers/j_integral.hpp, Algorithm 3); the damage and the flow of the new bond
+// set follow the mechanics (after_mechanics), then the crack's aperture.
 #ifndef MUPM_STEP_SEQUENCE_HPP
 #define MUPM_STEP_SEQUENCE_HPP
 
@@ -45,7 +46,7 @@ struct StepSequence {
       skeleton->move(t, dt);
       fluid->project(t, dt, *skeleton);
       skeleton->finish_forces(t, dt);
-      skeleton->complete(t, dt, crack_criterion(t + dt));
+      skeleton->complete(t, dt, breakage(t + dt));
       after_mechanics();
       fluid->finish_projection(dt);
       mechanics->update_density();
@@ -54,11 +55,9 @@ struct StepSequence {
     const double interval = fluid_every * dt;
     if (fluid && fluid_first && step % fluid_every == 0)
       advance_fluid(t, interval);
-    if (mechanics && j_criterion) {
+    if (mechanics) {
       mechanics->step_to_forces(t, dt);
-      mechanics->complete_step(t, dt, crack_criterion(t + dt));
-    } else if (mechanics) {
-      mechanics->step(t, dt);
+      mechanics->complete_step(t, dt, breakage(t + dt));
     }
     after_mechanics();
     // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
@@ -67,9 +66,13 @@ struct StepSequence {
   }
 
  private:
-  // The J criterion at the step's end time: the directed bonds it broke on this rank.
-  long long crack_criterion(double t_end) {
-    return j_criterion ? j_criterion->advance(t_end).bonds : 0;
+  // The step's bond breakage at its end time t_end: the bonds broken on this rank and the energy
+  // they released (the energy criterion's; the J criterion's release no bond energy).
+  Breakage breakage(double t_end) {
+    Breakage b = mechanics->energy_breakage();
+    if (j_criterion)
+      b.bonds += j_criterion->advance(t_end).bonds;
+    return b;
   }
   void after_mechanics() {
     // Bonds broke in the mechanics step: the damage changes (the pre-cracks' is computed at
