@@ -34,8 +34,9 @@ struct StepSequence {
   long long damage_seen = -1;  // broken bond pairs at the last damage update (bookkeeping)
 
   // Solver->Pressure Integration = Semi-Implicit: the solid's step split around the pressure
-  // solve (include/mupm/solvers/pressure_projection.hpp): move, pressure, finish, breakage and
-  // damage, then the fluid's water and energy bookkeeping; every step, no substeps.
+  // solve (include/mupm/solvers/pressure_projection.hpp): move, pressure, the forces, breakage,
+  // the velocities and damage, then the fluid's water and energy bookkeeping; every step, no
+  // substeps.
   Skeleton* skeleton = nullptr;
   // Fracture->Bond Breakage = J-Integral: Algorithm 3 after the mechanics' forces (header).
   JIntegral<Dim>* j_criterion = nullptr;
