@@ -34,8 +34,8 @@ std::vector<double> exact_sums(MPI_Comm comm, const double* terms, std::size_t r
       if (t == 0 || big[c] == HUGE_VAL)
         continue;
       const double q = std::ldexp(t, 32 - e[c]);  // exact: a power of two
-      const double hi = std::floor(q);
-      const double frac = q - hi;  // exact, in [0, 1)
+      const double hi = std::trunc(q);
+      const double frac = q - hi;  // exact (the bits of q below its units), in (-1, 1)
       sums[2 * c] += static_cast<std::int64_t>(hi);
       sums[2 * c + 1] += static_cast<std::int64_t>(std::nearbyint(std::ldexp(frac, 32)));
     }

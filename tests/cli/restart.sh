@@ -96,7 +96,7 @@ with h5py.File(f"{name}-straight/checkpoint.h5") as a, h5py.File(f"{name}-second
         dp = [float(rows[s]["plastic_dissipation"]) for s in (0, steps // 2, steps)]
         assert dp[0] == 0 < dp[1] < dp[2], dp
         print("restart %s: plastic dissipation %g -> %g (restart) -> %g J" % (name, *dp))
-    if "j_integral" in rows[0]:  # J, a sum over ranks in global-id order: the same bits
+    if "j_integral" in rows[0]:  # J, an exact sum over ranks (core/exact_sum.hpp): the same bits
         for part in ("first", "second"):  # 2 ranks, then 1 rank x 2 threads
             for r in csv.DictReader(open(f"{name}-{part}/time_series.csv")):
                 s = int(float(r["step"]))

@@ -3,11 +3,12 @@
 // its column over all ranks, into two integers that add exactly (integer addition is
 // associative), and only the integer sums travel (MPI_Allreduce).
 //
-// Column c with largest |term| < 2^e: q = t 2^(32-e) (|q| < 2^32), hi = floor(q), lo = the
-// nearest integer to (q - hi) 2^32; the sum is (sum hi + 2^-32 sum lo) 2^(e-32). A term loses
-// at most 2^(e-65) (half a unit of lo): relative to the largest term 2^-64, 1e-19, far below a
-// double's round-off of the sum. Up to 2^30 terms a column over all ranks (the integer sums
-// then stay below 2^62); more throws. A column with a term that is not finite sums to NaN.
+// Column c with largest |term| < 2^e: q = t 2^(32-e) (|q| < 2^32), hi = trunc(q) (|hi| < 2^32),
+// lo = the nearest integer to (q - hi) 2^32 (q - hi is exact, in (-1, 1), so |lo| <= 2^32); the
+// sum is (sum hi + 2^-32 sum lo) 2^(e-32). A term loses at most 2^(e-65) (half a unit of lo):
+// relative to the largest term 2^-64, 1e-19, far below a double's round-off of the sum. Up to
+// 2^30 terms a column over all ranks (the integer sums then stay within 2^62); more throws. A
+// column with a term that is not finite sums to NaN.
 #ifndef MUPM_CORE_EXACT_SUM_HPP
 #define MUPM_CORE_EXACT_SUM_HPP
 

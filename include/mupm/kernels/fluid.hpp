@@ -104,15 +104,16 @@ struct FluidState {
 // update books step by step.
 //
 // The nodes are q_k = t_k p with fixed t_k in (0, 1), so (-q_k / s_a)^n = (-p / s_a)^n t_k^n:
-// RetentionEnergy holds the t_k^n of a curve (made once per kernel launch, on the host), and a
-// point then takes one power for (-p / s_a)^n and one per node for S_r = (1 + x^n)^(-m), ten in
-// all where evaluating the curve at each node would take eighteen.
+// RetentionEnergy holds the t_k^n of a curve (the hot loops make one before their launch;
+// stored_energy_density and entry_pressure(vg, ...) one per call), and a point then takes one
+// power for (-p / s_a)^n and one per node for S_r = (1 + x^n)^(-m), ten in all where evaluating
+// the curve at each node would take eighteen.
 struct RetentionEnergy {
   static constexpr int kNodes = 8;
   VanGenuchten vg;
   Kokkos::Array<double, kNodes> t, w, tn;  // nodes on [0, 1] (of p), weights, t^n
 
-  explicit RetentionEnergy(const VanGenuchten& v) : vg(v) {
+  KOKKOS_INLINE_FUNCTION explicit RetentionEnergy(const VanGenuchten& v) : vg(v) {
     const double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
                          0.9602898564975363};
     const double wx[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
@@ -168,12 +169,18 @@ KOKKOS_INLINE_FUNCTION double entry_pressure(double p0, double dp, double C, dou
 KOKKOS_INLINE_FUNCTION bool storage_varies(const VanGenuchten& vg, double p0, double p1) {
   return vg.enabled && (p0 < 0 || p1 < 0);
 }
+KOKKOS_INLINE_FUNCTION double entry_pressure(const RetentionEnergy& e, double phi, double inv_kw,
+                                             double p0, double dp, double C, double cz = 0) {
+  if (!storage_varies(e.vg, p0, p0 + dp))
+    return p0 + 0.5 * dp;
+  return entry_pressure(p0, dp, C, e.density(phi, inv_kw, p0, cz),
+                        e.density(phi, inv_kw, p0 + dp, cz), true);
+}
 KOKKOS_INLINE_FUNCTION double entry_pressure(const VanGenuchten& vg, double phi, double inv_kw,
                                              double p0, double dp, double C, double cz = 0) {
   if (!storage_varies(vg, p0, p0 + dp))
     return p0 + 0.5 * dp;
-  return entry_pressure(p0, dp, C, stored_energy_density(vg, phi, inv_kw, p0, cz),
-                        stored_energy_density(vg, phi, inv_kw, p0 + dp, cz), true);
+  return entry_pressure(RetentionEnergy(vg), phi, inv_kw, p0, dp, C, cz);
 }
 
 // Saturation (eq 12), relative permeability (eq 56), storage C (with plane stress's c_z term,

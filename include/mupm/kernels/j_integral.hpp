@@ -1,6 +1,6 @@
 // The micropolar J-integral on rectangular contours around a crack tip (paper eqs 30, 125,
 // 126). 2D (plane strain or stress, thickness h). Kernels only: the per-point terms; the solver
-// sums them over the ranks in a fixed order (include/mupm/solvers/j_integral.hpp).
+// sums them over the ranks exactly, in any order (include/mupm/solvers/j_integral.hpp).
 //
 // Derivation (the paper's eq 30 carries its cross term with one xi for two bonds; this is the
 // reading that follows from the model's own energy: the discrete energy Psi whose derivatives are

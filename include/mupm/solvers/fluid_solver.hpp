@@ -405,7 +405,7 @@ class FluidSolver : public Module {
     auto C = c_old_, sr = sr_old_, f0 = flow_old_, hdp = hdp_, ddp = dp_, src = source_;
     auto lag = lag_, now = shift_;
     const bool lagged = shift_.extent(0) > 0;
-    const VanGenuchten vg = prm_.retention;
+    const RetentionEnergy energy(prm_.retention);
     const double inv_kw = 1.0 / prm_.bulk_modulus;
     const double biot = prm_.pore.biot, cz = prm_.pore.lateral_compliance;
     double w[3] = {0, 0, 0};
@@ -422,7 +422,7 @@ class FluidSolver : public Module {
           target(i) = held ? vol(i) * (C(i) * dp - rhs) : 0.0;  // the reservoir's water [m^3]
           const double pm = p0 + 0.5 * dp;
           const double pe = src(i) != 0 || held
-                                ? entry_pressure(vg, phi(i), inv_kw, p0, dp, C(i), cz)
+                                ? entry_pressure(energy, phi(i), inv_kw, p0, dp, C(i), cz)
                                 : p0 + 0.5 * dp;
           wc += vol(i) * pm * biot * sr(i) * dv;
           wd += vol(i) * pm * dt * flow;

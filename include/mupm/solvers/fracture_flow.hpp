@@ -652,6 +652,7 @@ class FractureFlow {
     auto& p = disc_.points;
     const std::size_t n = net_.size();
     const VanGenuchten vg = fluid_.retention;
+    const RetentionEnergy energy(vg);
     for (std::size_t k = 0; k < n; ++k) {
       p.pf(net_[k].i) = x_[k];
       p.pf_saturation(net_[k].i) = vg.saturation(x_[k]);
@@ -672,9 +673,8 @@ class FractureFlow {
       const double pm = 0.5 * (pold + x_[k]);
       const double exch = dt * v * gexch_[k] * (nd.phat - x_[k]);
       double gain = dt * (flow + source_[k]) + exch;
-      de[0] += v * phi_f_[k] *
-               (stored_energy_density(vg, 1.0, inv_kw, x_[k]) -
-                stored_energy_density(vg, 1.0, inv_kw, pold));
+      de[0] +=
+          v * phi_f_[k] * (energy.density(1.0, inv_kw, x_[k]) - energy.density(1.0, inv_kw, pold));
       if (!implicit_)  // implicit: implicit_opening, with the opening the step reached
         de[1] += pm * v * opening_[k];
       de[2] -= pm * dt * flow;
