@@ -37,11 +37,13 @@ Distribution::Distribution(const Teuchos::RCP<const Comm>& comm, const std::vect
 }
 
 Distribution::Buffers& Distribution::buffers(std::map<std::size_t, Buffers>& kept,
-                                             std::size_t width) {
+                                             std::size_t width,
+                                             const Teuchos::RCP<const Map>& source,
+                                             const Teuchos::RCP<const Map>& target) {
   Buffers& b = kept[width];
-  if (b.owned.is_null()) {
-    b.owned = Teuchos::rcp(new MultiVector(owned_map_, width, false));
-    b.overlap = Teuchos::rcp(new MultiVector(overlap_map_, width, false));
+  if (b.source.is_null()) {
+    b.source = Teuchos::rcp(new MultiVector(source, width, false));
+    b.target = Teuchos::rcp(new MultiVector(target, width, false));
   }
   return b;
 }
@@ -53,15 +55,11 @@ void Distribution::refresh(const std::vector<Vectors>& fields) {
     width += f.extent(1);
   if (width == 0)
     return;
-  Buffers& bufs = refresh_bufs_[width];
-  if (bufs.owned.is_null()) {
-    bufs.owned = Teuchos::rcp(new MultiVector(sent_map_, width, false));
-    bufs.overlap = Teuchos::rcp(new MultiVector(ghost_map_, width, false));
-  }
+  const Buffers& bufs = buffers(refresh_bufs_, width, sent_map_, ghost_map_);
   const std::size_t n_own = n_owned_;
   const auto lids = sent_lids_;
   {
-    auto buf = bufs.owned->getLocalViewDevice(Tpetra::Access::OverwriteAll);
+    auto buf = bufs.source->getLocalViewDevice(Tpetra::Access::OverwriteAll);
     std::size_t col = 0;
     for (const auto& f : fields) {
       const std::size_t nc = f.extent(1), c0 = col;
@@ -73,9 +71,9 @@ void Distribution::refresh(const std::vector<Vectors>& fields) {
       col += nc;
     }
   }
-  bufs.overlap->doImport(*bufs.owned, *ghost_importer_, Tpetra::INSERT);
+  bufs.target->doImport(*bufs.source, *ghost_importer_, Tpetra::INSERT);
   {
-    auto buf = bufs.overlap->getLocalViewDevice(Tpetra::Access::ReadOnly);
+    auto buf = bufs.target->getLocalViewDevice(Tpetra::Access::ReadOnly);
     std::size_t col = 0;
     for (const auto& f : fields) {
       const std::size_t nc = f.extent(1), c0 = col;
@@ -96,20 +94,20 @@ void Distribution::add_to_owners(const Vectors& buf) {
   const std::size_t width = buf.extent(1);
   if (width == 0)
     return;
-  const Buffers& bufs = buffers(sum_bufs_, width);
+  const Buffers& bufs = buffers(sum_bufs_, width, owned_map_, overlap_map_);
   const std::size_t n_own = n_owned_, n_all = n_owned_ + n_ghost_;
   {
-    auto b = bufs.overlap->getLocalViewDevice(Tpetra::Access::OverwriteAll);
+    auto b = bufs.target->getLocalViewDevice(Tpetra::Access::OverwriteAll);
     Kokkos::parallel_for(
         "mupm::Comm::pack_sum", range(0, n_all), KOKKOS_LAMBDA(const std::size_t i) {
           for (std::size_t c = 0; c < width; ++c)
             b(i, c) = buf(i, c);
         });
   }
-  bufs.owned->putScalar(0.0);
-  bufs.owned->doExport(*bufs.overlap, *importer_, Tpetra::ADD);
+  bufs.source->putScalar(0.0);
+  bufs.source->doExport(*bufs.target, *importer_, Tpetra::ADD);
   {
-    auto b = bufs.owned->getLocalViewDevice(Tpetra::Access::ReadOnly);
+    auto b = bufs.source->getLocalViewDevice(Tpetra::Access::ReadOnly);
     Kokkos::parallel_for(
         "mupm::Comm::unpack_sum", range(0, n_own), KOKKOS_LAMBDA(const std::size_t i) {
           for (std::size_t c = 0; c < width; ++c)

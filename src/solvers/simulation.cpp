@@ -284,10 +284,12 @@ struct Assembly {
         out.push_back(r);
       }
     }
-    out.push_back({"stable_steps/broken_pairs_at_estimate", nullptr, &watch.pairs_at});
-    out.push_back({"stable_steps/min_storage_at_estimate", &watch.storage_at});
-    out.push_back({"stable_steps/fluid_substeps", nullptr, &watch.substeps});
-    out.push_back({"stable_steps/time_step", &watch.time_step});
+    GlobalRefs w;
+    w("stable_steps/broken_pairs_at_estimate", watch.pairs_at);
+    w("stable_steps/min_storage_at_estimate", watch.storage_at);
+    w("stable_steps/fluid_substeps", watch.substeps);
+    w("stable_steps/time_step", watch.time_step);
+    out.insert(out.end(), w.refs().begin(), w.refs().end());
     return out;
   }
 };

@@ -132,13 +132,13 @@ struct RetentionEnergy {
       return 0.5 * (phi * inv_kw + cz) * p * p;
     const double x = -p / vg.air_entry;
     const double xn = std::pow(x, vg.n);
-    const double sp = std::pow(1 + xn, -vg.m) * p;  // S_r(p) p, S_r as VanGenuchten::saturation
+    const double sp = vg.saturation_from(xn) * p;  // S_r(p) p
     double s = 0;
     for (int k = 0; k < kNodes; ++k) {
-      // S_r and dS_r/dp at q = t p, as VanGenuchten::saturation_and_slope from x t and (x t)^n.
+      // S_r and dS_r/dp at q = t p, from x t and (x t)^n = x^n t^n.
       const double xk = x * t[k], xnk = xn * tn[k];
-      const double sq = std::pow(1 + xnk, -vg.m);
-      const double dsq = vg.m * vg.n * (xnk / xk) * (sq / (1 + xnk)) / vg.air_entry;
+      const double sq = vg.saturation_from(xnk);
+      const double dsq = vg.slope_from(xk, xnk, sq);
       s += w[k] * phi * (dsq + sq * inv_kw) * (t[k] * p);
     }
     return 0.5 * p * s +

@@ -27,7 +27,13 @@ struct VanGenuchten {
   KOKKOS_INLINE_FUNCTION double saturation(double p) const {
     if (!enabled || p >= 0)
       return 1.0;
-    return std::pow(1 + std::pow(-p / air_entry, n), -m);
+    return saturation_from(std::pow(-p / air_entry, n));
+  }
+  // S_r and dS_r/dp from x = s/s_a and x^n (p < 0): for callers that have x^n already
+  // (include/mupm/kernels/fluid.hpp, RetentionEnergy).
+  KOKKOS_INLINE_FUNCTION double saturation_from(double xn) const { return std::pow(1 + xn, -m); }
+  KOKKOS_INLINE_FUNCTION double slope_from(double x, double xn, double s_r) const {
+    return m * n * (xn / x) * (s_r / (1 + xn)) / air_entry;
   }
   // dS_r/dp = m n (s/s_a)^(n-1) [1 + (s/s_a)^n]^(-m-1) / s_a with s = -p (>= 0: drying lowers
   // S_r as p falls), written m n (x^n / x) (S_r / (1 + x^n)) / s_a with x = s/s_a: the two powers
@@ -46,8 +52,8 @@ struct VanGenuchten {
     }
     const double x = -p / air_entry;
     const double xn = std::pow(x, n);
-    s_r = std::pow(1 + xn, -m);
-    ds = m * n * (xn / x) * (s_r / (1 + xn)) / air_entry;
+    s_r = saturation_from(xn);
+    ds = slope_from(x, xn, s_r);
   }
   KOKKOS_INLINE_FUNCTION double relative_permeability(double sr) const {
     if (!enabled || sr >= 1)

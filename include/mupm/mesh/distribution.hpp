@@ -61,9 +61,10 @@ class Distribution {
   // few widths in turn, and a buffer made anew for each would be allocated (and Tpetra's
   // communication buffers with it) several times a step.
   struct Buffers {
-    Teuchos::RCP<MultiVector> owned, overlap;
+    Teuchos::RCP<MultiVector> source, target;
   };
-  Buffers& buffers(std::map<std::size_t, Buffers>& kept, std::size_t width);
+  Buffers& buffers(std::map<std::size_t, Buffers>& kept, std::size_t width,
+                   const Teuchos::RCP<const Map>& source, const Teuchos::RCP<const Map>& target);
   std::map<std::size_t, Buffers> refresh_bufs_, sum_bufs_;  // refresh, add_to_owners
 };
 
