@@ -12,6 +12,7 @@
 #include "mupm/input/model.hpp"
 #include "mupm/kernels/fracture_flow.hpp"
 #include "mupm/solvers/damage.hpp"
+#include "mupm/solvers/fracture_flow.hpp"
 #include "mupm/solvers/solid_solver.hpp"
 #include "mupm/solvers/step_sequence.hpp"
 

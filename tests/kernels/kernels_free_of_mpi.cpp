@@ -10,6 +10,7 @@
 #include "mupm/kernels/shape_tensor.hpp"
 #include "mupm/kernels/shear_bands.hpp"
 #include "mupm/kernels/solid.hpp"
+#include "mupm/kernels/solid_energy.hpp"
 #include "mupm/laws/micropolar_drucker_prager.hpp"
 #include "mupm/laws/micropolar_elastic.hpp"
 #include "mupm/laws/stabilization.hpp"

@@ -17,6 +17,8 @@
 #include "mupm/kernels/fracture_flow.hpp"
 #include "mupm/solvers/damage.hpp"
 #include "mupm/solvers/fluid_solver.hpp"
+#include "mupm/solvers/fracture_flow.hpp"
+#include "mupm/solvers/linear_solve.hpp"
 #include "mupm/solvers/solid_solver.hpp"
 #include "mupm/solvers/step_sequence.hpp"
 #include "test_utils.hpp"

@@ -17,7 +17,7 @@
 #include "mupm/kernels/solid.hpp"
 #include "mupm/laws/micropolar_drucker_prager.hpp"
 #include "mupm/mesh/grid.hpp"
-#include "mupm/solvers/linear_solve.hpp"
+#include "mupm/solvers/linear_solve_settings.hpp"
 
 namespace mupm {
 

@@ -29,7 +29,7 @@
 // (Kim, Tchelepi & Juanes 2011 analyse the same splits for implicit coupling.)
 //
 // Kernels only: no MPI; the solver refreshes the ghosts between the passes
-// (include/mupm/solvers/solid_solver.hpp, solid_forces).
+// (include/mupm/solvers/solid_forces.hpp).
 //
 // A point whose intact bonds leave K singular (det K below 1e-6 of a well-conditioned K of the
 // same trace) is "degenerate": eps = kappa = 0 there and its bonds act as the stabilization

@@ -54,9 +54,9 @@
 // content with the skeleton's actual volume change and the linearized flow div(p_n) + H dp,
 // whose volume integral is zero (H 1 = 0), so the CSV's water mass error is the accumulated
 // residual of the solves. Energy: the solid's ledger is the central difference's
-// L_n = E_int(u_n) + 1/2 m |v_n|^2 - dt^2/8 m |a_n|^2 (solid_solver.hpp, Energy::kinetic_shift),
-// a_n from the forces at t_n with p_n. In leapfrog form the impulse over the step centred at
-// t_n is dt (F_n + B~^T p_{n+1}) (above), and for a linear skeleton
+// L_n = E_int(u_n) + 1/2 m |v_n|^2 - dt^2/8 m |a_n|^2 (solid_ledger.hpp,
+// SolidEnergy::kinetic_shift), a_n from the forces at t_n with p_n. In leapfrog form the impulse
+// over the step centred at t_n is dt (F_n + B~^T p_{n+1}) (above), and for a linear skeleton
 //   1/2 m |v_{n+1/2}|^2 - 1/2 m |v_{n-1/2}|^2 = (F_n + B~^T p_{n+1}) . (u_{n+1} - u_{n-1}) / 2
 // together with L_n = 1/2 m |v_{n-1/2}|^2 + 1/2 u_{n-1} . K u_n + 1/2 (u_n - u_{n-1}) . G_n
 // (G_n the pressure's and the external force at t_n; v_n = v_{n-1/2} + dt/2 a_n) give exactly
@@ -132,7 +132,7 @@
 // the explicit step; here the faces see p_f^{n+1} of the implicit balance, so the crack water
 // is a constraint (incompressible) or an implicit stiffness, as the bulk water is, and the
 // step is the drained skeleton's (the solid's estimate leaves the crack water out,
-// solvers/solid_solver.hpp). A point that joins the network takes p_f^n = p^n (its bulk
+// src/solvers/solid_stable_step.cpp). A point that joins the network takes p_f^n = p^n (its bulk
 // pressure) for its storage and flows, but its faces have felt no p_f yet: its correction
 // applies p_f^n too (CrackBlock::unfelt). Conservation: the crack water's content grows by the
 // flows, sources and exchange the solve used (fracture_flow.hpp), the bulk loses the same
@@ -230,152 +230,11 @@ class PressureProjection {
   // global).
   Result step(double dt, const FluidParams& prm, const FluidState<Dim>& st, const Scalars& source,
               const Scalars& target, const SkeletonState& sk, const Scalars& dp, double& scale,
-              const CrackBlock& crack, std::vector<double>& dpf) {
-    ScopedRegion region("mupm::Pressure::projection");
-    auto& p = disc_.points;
-    const std::size_t n = p.n_owned, m = crack.point.size();
-    const bool refilled = needs_assembly(dt, st, sk, crack);
-    if (refilled)
-      assemble(dt, prm, st, sk, crack);
-    Teuchos::RCP<CrsMatrix> network;
-    if (any_crack_) {  // the network's rows change every step (apertures): new values
-      network = network_rows(crack);
-      auto ns = Teuchos::rcp(new CrsMatrix(joint_, 0));
-      Tpetra::MatrixMatrix::Multiply(*network, false, *s_h_.matrix(), false, *ns);
-      ns->leftScale(*keep_);
-      compose(*ns);
-    } else if (system_ != composed_.matrix()) {
-      system_ = composed_.matrix();
-      solver_.set_matrix(system_);
-    } else if (refilled || solver_.renewal_pending()) {
-      // New values on the kept graph (or a checkpoint's renewal of the factors: a restart
-      // computes them from these values).
-      solver_.refresh();
-    }
-    const auto& owned = disc_.dist.owned_map();
-    TpetraVector &du = work(kDu, dofs_), &bp = work(kBp, owned), &b = work(kB, joint_),
-                 &c = work(kC, joint_), &ac = work(kAc, joint_), &x = work(kX, joint_),
-                 &y = work(kY, joint_);
-    {
-      auto v = du.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (std::size_t i = 0; i < n; ++i) {
-        for (int d = 0; d < Dim; ++d)
-          v(i * NC + d, 0) = p.u(i, d) - sk.start(i, d);
-        for (int r = 0; r < R; ++r)
-          v(i * NC + Dim + r, 0) = p.theta(i, r) - sk.start(i, Dim + r);
-      }
-    }
-    coupling_.matrix()->apply(du, bp);  // B_0 du, then diag(S_r)
-    bp.elementWiseMultiply(1.0, *saturation_, bp, 0.0);
-    {
-      auto cv = c.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (std::size_t i = 0; i < n; ++i)
-        cv(i, 0) = roles_[i] == PressureRole::Free ? 0.0 : target(i) - p.p(i);
-      for (std::size_t k = 0; k < m; ++k)
-        cv(n + k, 0) = crack.held[k] ? crack.start[k] : 0.0;
-    }
-    static_.matrix()->apply(c, ac);      // A c = (static part + the network's rows) c
-    TpetraVector& e = work(kE, joint_);  // the unfelt p_f^n (CrackBlock): the correction applies it
-    if (any_crack_) {
-      network->apply(c, ac, Teuchos::NO_TRANS, 1.0, 1.0);
-      {
-        auto ev = e.getLocalViewHost(Tpetra::Access::OverwriteAll);
-        for (std::size_t i = 0; i < n; ++i)
-          ev(i, 0) = 0.0;
-        for (std::size_t k = 0; k < m; ++k)
-          ev(n + k, 0) = crack.unfelt[k];
-      }
-      // ... and the volume change it gives the skeleton within the step: dt^2 B M^-1 B^T e.
-      TpetraVector &fe = work(kFe, dofs_), &be = work(kBe, joint_);
-      coupling_s_->apply(e, fe, Teuchos::TRANS);
-      fe.elementWiseMultiply(1.0, *inverse_mass_, fe, 0.0);
-      coupling_s_->apply(fe, be);
-      ac.update(dt * dt, be, 1.0);
-    } else {
-      e.putScalar(0.0);
-    }
-    {
-      auto bv = b.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      auto pv = bp.getLocalViewHost(Tpetra::Access::ReadOnly);
-      auto av = ac.getLocalViewHost(Tpetra::Access::ReadOnly);
-      for (std::size_t i = 0; i < n; ++i)
-        bv(i, 0) =
-            solved_[i] ? -pv(i, 0) + dt * p.volume(i) * (source(i) - st.flow(i)) - av(i, 0) : 0.0;
-      for (std::size_t k = 0; k < m; ++k) {
-        const LocalId i = crack.point[k];  // the exchange at p^n, p_f^n
-        if (solved_[std::size_t(i)])
-          bv(i, 0) -= crack.exchange[k] * (p.p(i) - crack.pf0[k]);
-        bv(n + k, 0) = solved_[n + k] ? crack.rhs[k] - av(n + k, 0) : 0.0;
-      }
-    }
-    // The previous step's increment (p_rate dt, checkpointed: a restart starts the same
-    // iteration) starts the iteration: the increments change smoothly.
-    {
-      auto xv = x.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (std::size_t i = 0; i < n; ++i)
-        xv(i, 0) = solved_[i] ? p.p_rate(i) * dt : 0.0;
-      for (std::size_t k = 0; k < m; ++k)
-        xv(n + k, 0) = solved_[n + k] ? crack.start[k] : 0.0;
-    }
-    Result r;
-    const auto res = solver_.solve(b, x, scale);
-    r.iterations = res.iterations;
-    r.residual = res.residual;
-    r.converged = res.converged;
-    r.finite_rhs = res.finite_rhs;
-    s_h_.matrix()->apply(x, y);  // the increments: S_H x + c
-    y.update(1.0, c, 1.0);
-    TpetraVector &yp = work(kYp, joint_), &f = work(kF, dofs_);  // the skeleton's correction:
-                                                                 // S_P x + c
-    s_p_.matrix()->apply(x, yp);
-    yp.update(1.0, c, 1.0, e, 1.0);
-    coupling_s_->apply(yp, f, Teuchos::TRANS);
-    double correction_work = 0;
-    {
-      auto yv = y.getLocalViewHost(Tpetra::Access::ReadOnly);
-      auto fv = f.getLocalViewHost(Tpetra::Access::ReadOnly);
-      auto mv = inverse_mass_->getLocalViewHost(Tpetra::Access::ReadOnly);
-      dpf.assign(m, 0.0);
-      for (std::size_t k = 0; k < m; ++k)
-        dpf[k] = yv(n + k, 0);
-      for (std::size_t i = 0; i < n; ++i) {
-        dp(i) = yv(i, 0);
-        for (int k = 0; k < NC; ++k) {
-          const std::size_t q = i * NC + std::size_t(k);
-          const double a = mv(q, 0) * fv(q, 0);
-          if (a == 0)
-            continue;
-          double& pos = k < Dim ? p.u(i, k) : p.theta(i, k - Dim);
-          double& vel = k < Dim ? p.v(i, k) : p.omega(i, k - Dim);
-          // u_n - u_(n-1) = dt v_(n-1/2) = dt (v* - dt a_n) (header: the projection work)
-          const double acc = k < Dim ? p.a(i, k) : p.alpha(i, k - Dim);
-          const double before = dt * (vel - dt * acc);
-          pos += dt * dt * a;
-          vel += dt * a;
-          correction_work += 0.5 * fv(q, 0) * (pos - sk.start(i, k) + before);
-        }
-      }
-    }
-    MPI_Allreduce(MPI_IN_PLACE, &correction_work, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    r.work = correction_work;
-    return r;
-  }
+              const CrackBlock& crack, std::vector<double>& dpf);
 
   // V H dp [n_owned] with the flow operator of the last assembly (the flow's linearized
   // increment, for the water bookkeeping).
-  void flow_increment(const Scalars& dp, const Scalars& out) const {
-    const auto& owned = disc_.dist.owned_map();
-    TpetraVector &x = work(kFlowX, owned), &y = work(kFlowY, owned);
-    {
-      auto v = x.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (std::size_t i = 0; i < disc_.points.n_owned; ++i)
-        v(i, 0) = dp(i);
-    }
-    flow_.matrix()->apply(x, y);
-    auto v = y.getLocalViewHost(Tpetra::Access::ReadOnly);
-    for (std::size_t i = 0; i < disc_.points.n_owned; ++i)
-      out(i) = v(i, 0);
-  }
+  void flow_increment(const Scalars& dp, const Scalars& out) const;
 
  private:
   // The state the matrix's values depend on, besides the bonds (invalidate): dt, S_r, k_r, C,
@@ -383,49 +242,15 @@ class PressureProjection {
   // and the columns of B_f: structure_ when they changed (the same on every rank).
   static constexpr std::size_t kSeen = 5;
   bool needs_assembly(double dt, const FluidState<Dim>& st, const SkeletonState& sk,
-                      const CrackBlock& crack) {
-    const auto& p = disc_.points;
-    const std::size_t n = p.n_owned;
-    int flags[4] = {stale_ || dt != dt_ ? 1 : 0, crack.point.empty() ? 0 : 1, 0, 0};
-    int& changed = flags[0];
-    int& structure = flags[2];
-    int& geometry = flags[3];  // the bonds or B_f changed: B_0, Gr and their transposes
-    structure = composed_.matrix().is_null() || crack.point != crack_points_ ||
-                crack.held != crack_held_ || !same_columns(crack.coupling, crack_coupling_);
-    geometry = structure || stale_ || crack.coupling != crack_coupling_;
-    changed = changed || geometry;
-    for (std::size_t i = 0; i < n && !changed; ++i)
-      changed = seen_[kSeen * i] != p.saturation(i) || seen_[kSeen * i + 1] != p.rel_perm(i) ||
-                seen_[kSeen * i + 2] != sk.density(i) || seen_[kSeen * i + 3] != sk.inertia(i) ||
-                seen_[kSeen * i + 4] != st.storage(i);
-    MPI_Allreduce(MPI_IN_PLACE, flags, 4, MPI_INT, MPI_MAX, comm_);
-    any_crack_ = flags[1] != 0;
-    structure_ = structure != 0;
-    geometry_ = geometry != 0;
-    return changed != 0;
-  }
+                      const CrackBlock& crack);
   // Whether two sets of B_f rows have the same columns (values aside).
   static bool same_columns(const std::vector<std::vector<std::pair<GlobalId, double>>>& a,
-                           const std::vector<std::vector<std::pair<GlobalId, double>>>& b) {
-    if (a.size() != b.size())
-      return false;
-    for (std::size_t k = 0; k < a.size(); ++k)
-      if (!std::equal(a[k].begin(), a[k].end(), b[k].begin(), b[k].end(),
-                      [](const auto& x, const auto& y) { return x.first == y.first; }))
-        return false;
-    return true;
-  }
+                           const std::vector<std::vector<std::pair<GlobalId, double>>>& b);
 
   // CG where the system is symmetric: without image points (S_H = S_P = R in assemble, and the
   // network's rows are symmetric: Lambda_ij = Lambda_ji, the exchange on both sides); GMRES
   // with images (an image's row and column differ). The same choice on every rank.
-  static bool any_images(const std::vector<PressureRole>& roles, MPI_Comm comm) {
-    int images = 0;
-    for (const PressureRole r : roles)
-      images |= r == PressureRole::OddImage || r == PressureRole::EvenImage;
-    MPI_Allreduce(MPI_IN_PLACE, &images, 1, MPI_INT, MPI_MAX, comm);
-    return images != 0;
-  }
+  static bool any_images(const std::vector<PressureRole>& roles, MPI_Comm comm);
   static LinearSolveSettings krylov(LinearSolveSettings s, bool images) {
     s.method = images ? "GMRES" : "CG";
     return s;
@@ -437,268 +262,17 @@ class PressureProjection {
   // kept, so a restart, which builds it again, gives the same matrix) and the preconditioner's
   // numeric part alone is computed again when the refresh interval is up
   // (LinearSolve::refresh).
-  void compose(const CrsMatrix& ns) {
-    ScopedRegion region("mupm::Pressure::compose");
-    const auto nl = ns.getLocalMatrixHost();
-    const auto& ncols = *ns.getColMap();
-    std::vector<GlobalId> pattern;  // (row, column) gids of ns's entries, in its storage order
-    pattern.reserve(2 * nl.values.extent(0));
-    for (LocalId r = 0; r < LocalId(nl.numRows()); ++r)
-      for (auto q = nl.graph.row_map(r); q < nl.graph.row_map(r + 1); ++q) {
-        pattern.push_back(joint_->getGlobalElement(r));
-        pattern.push_back(ncols.getGlobalElement(nl.graph.entries(q)));
-      }
-    const auto& composed = composed_.matrix();
-    int rebuild = system_.is_null() || system_ == composed || pattern != pattern_ ? 1 : 0;
-    MPI_Allreduce(MPI_IN_PLACE, &rebuild, 1, MPI_INT, MPI_MAX, comm_);
-    if (rebuild) {
-      system_ = Tpetra::MatrixMatrix::add(1.0, false, *composed, 1.0, false, ns);
-      if (!system_->getRowMap()->isSameAs(*joint_) || !composed->getRowMap()->isSameAs(*joint_))
-        throw std::logic_error("PressureProjection::compose: the rows are not the joint map's");
-      const auto sl = system_->getLocalMatrixHost();
-      const auto& scols = *system_->getColMap();
-      // The position in system_ of row r's entry at global column g.
-      auto at = [&](LocalId r, GlobalId g) {
-        for (auto q = sl.graph.row_map(r); q < sl.graph.row_map(r + 1); ++q)
-          if (scols.getGlobalElement(sl.graph.entries(q)) == g)
-            return std::size_t(q);
-        throw std::logic_error("PressureProjection::compose: an entry is not in the sum's graph");
-      };
-      const auto cl = composed->getLocalMatrixHost();
-      const auto& ccols = *composed->getColMap();
-      base_.resize(cl.values.extent(0));
-      for (LocalId r = 0; r < LocalId(cl.numRows()); ++r)
-        for (auto q = cl.graph.row_map(r); q < cl.graph.row_map(r + 1); ++q)
-          base_[std::size_t(q)] = at(r, ccols.getGlobalElement(cl.graph.entries(q)));
-      where_.resize(nl.values.extent(0));
-      for (std::size_t q = 0; q < where_.size(); ++q)
-        where_[q] = at(joint_->getLocalElement(pattern[2 * q]), pattern[2 * q + 1]);
-      pattern_ = std::move(pattern);
-    }
-    {
-      const auto v = system_->getLocalValuesView();
-      const auto cv = composed->getLocalValuesView();
-      for (std::size_t q = 0; q < v.extent(0); ++q)
-        v(q) = 0.0;
-      for (std::size_t q = 0; q < base_.size(); ++q)
-        v(base_[q]) = cv(q);
-      for (std::size_t q = 0; q < where_.size(); ++q)
-        v(where_[q]) += nl.values(q);
-    }
-    if (rebuild)
-      solver_.set_matrix(system_);
-    else
-      solver_.refresh();
-  }
+  void compose(const CrsMatrix& ns);
 
   // The network's rows of the step (CrackBlock, header): storage, flow and exchange on the
   // fracture pressures' rows, the exchange on its points' pore-pressure rows.
-  Teuchos::RCP<CrsMatrix> network_rows(const CrackBlock& crack) const {
-    const auto& p = disc_.points;
-    std::size_t longest = 2;
-    for (const auto& f : crack.flow)
-      longest = std::max(longest, f.size() + 2);
-    auto a = Teuchos::rcp(new CrsMatrix(joint_, longest));
-    std::vector<GlobalId> cols;
-    std::vector<double> vals;
-    for (std::size_t k = 0; k < crack.point.size(); ++k) {
-      const GlobalId g = p.gid(crack.point[k]), gf = crack.offset + g;
-      const double ex = crack.exchange[k];
-      cols = {g, gf};
-      vals = {ex, -ex};
-      a->insertGlobalValues(g, Teuchos::ArrayView<const GlobalId>(cols),
-                            Teuchos::ArrayView<const double>(vals));
-      double diag = crack.storage[k] + ex;
-      cols = {g};
-      vals = {-ex};
-      for (const auto& e : crack.flow[k]) {
-        cols.push_back(e.first);
-        vals.push_back(-e.second);
-        diag += e.second;
-      }
-      cols.push_back(gf);
-      vals.push_back(diag);
-      a->insertGlobalValues(gf, Teuchos::ArrayView<const GlobalId>(cols),
-                            Teuchos::ArrayView<const double>(vals));
-    }
-    a->fillComplete(joint_, joint_);
-    return a;
-  }
+  Teuchos::RCP<CrsMatrix> network_rows(const CrackBlock& crack) const;
 
   // The system's graphs (structure_: built again) and values. Every value comes from the
   // kept-graph operations (include/mupm/solvers/kept_matrix.hpp) whether the graph is new or
   // kept: a restart, which builds the graphs, gives the straight run's matrix.
   void assemble(double dt, const FluidParams& prm, const FluidState<Dim>& st,
-                const SkeletonState& sk, const CrackBlock& crack) {
-    const bool build = structure_;
-    ScopedRegion region(build ? "mupm::Pressure::assemble" : "mupm::Pressure::refill");
-    auto& p = disc_.points;
-    const std::size_t n = p.n_owned, m = crack.point.size();
-    seen_.resize(kSeen * n);
-    for (std::size_t i = 0; i < n; ++i) {
-      seen_[kSeen * i] = p.saturation(i);
-      seen_[kSeen * i + 1] = p.rel_perm(i);
-      seen_[kSeen * i + 2] = sk.density(i);
-      seen_[kSeen * i + 3] = sk.inertia(i);
-      seen_[kSeen * i + 4] = st.storage(i);
-    }
-    crack_points_ = crack.point;
-    crack_held_ = crack.held;
-    crack_coupling_ = crack.coupling;
-    // The joint map: the owned points' pore pressures, then their fracture pressures.
-    if (build) {
-      std::vector<GlobalId> ids(n + m);
-      for (std::size_t i = 0; i < n; ++i)
-        ids[i] = p.gid(i);
-      for (std::size_t k = 0; k < m; ++k)
-        ids[n + k] = offset_ + p.gid(crack.point[k]);
-      const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
-      joint_ = Teuchos::rcp(
-          new Map(invalid, Teuchos::ArrayView<const GlobalId>(ids), 0, disc_.dist.comm()));
-    }
-    // The flow operator with the pressure stabilization added to the flow's (header).
-    Scalars alpha("mupm::projection_alpha", p.size());
-    Kokkos::deep_copy(alpha, st.alpha);
-    add_pressure_stabilization(disc_, prm, dt, sk.density, alpha);
-    GlobalRows extra;
-    for (std::size_t k = 0; k < m; ++k)
-      extra.push_back({offset_ + p.gid(crack.point[k]), crack.coupling[k]});
-    if (build) {
-      flow_.build(disc_, prm, alpha);
-      coupling_.build(disc_, prm.pore.biot);
-      joint_flow_.build(flow_.matrix().get(), joint_, {}, joint_, joint_);
-      joint_coupling_.build(coupling_.matrix().get(), joint_, extra, dofs_, joint_);
-      inverse_mass_ = Teuchos::rcp(new TpetraVector(dofs_));
-      saturation_ = Teuchos::rcp(new TpetraVector(disc_.dist.owned_map()));
-      sigma_ = Teuchos::rcp(new TpetraVector(joint_));
-    } else {
-      flow_.fill(disc_, prm, alpha, geometry_);
-      joint_flow_.fill(flow_.matrix().get(), {});
-      if (geometry_) {
-        coupling_.fill(disc_, prm.pore.biot);
-        joint_coupling_.fill(coupling_.matrix().get(), extra);
-      }
-    }
-    // B = diag(sigma) [B_0; B_f]: sigma = S_r on the points' rows, 1 on the network's.
-    {
-      auto sv = saturation_->getLocalViewHost(Tpetra::Access::OverwriteAll);
-      auto gv = sigma_->getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (std::size_t i = 0; i < n; ++i)
-        sv(i, 0) = gv(i, 0) = p.saturation(i);
-      for (std::size_t k = 0; k < m; ++k)
-        gv(n + k, 0) = 1.0;
-    }
-    copy_values(coupling_s_, *joint_coupling_.matrix(), build);
-    coupling_s_->leftScale(*sigma_);
-    if (geometry_)
-      coupling_t_ = transpose(joint_coupling_.matrix());  // [B_0; B_f]^T
-    TpetraVector storage(joint_);
-    {
-      auto mv = inverse_mass_->getLocalViewHost(Tpetra::Access::OverwriteAll);
-      auto sv = storage.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (std::size_t i = 0; i < n; ++i) {
-        const std::uint32_t fx = p.fixed(i);
-        for (int k = 0; k < NC; ++k) {
-          const double mass = p.volume(i) * (k < Dim ? sk.density(i) : sk.inertia(i));
-          mv(i * NC + k, 0) = (fx & (1u << k)) || !(mass > 0) ? 0.0 : 1.0 / mass;
-        }
-        sv(i, 0) = p.volume(i) * st.storage(i);
-      }
-      for (std::size_t k = 0; k < m; ++k)
-        sv(n + k, 0) = 0.0;  // the network's storage is in its rows of the step
-    }
-    // B M^-1 B^T = (B M^-1) [B_0; B_f]^T diag(sigma): B M^-1 a copy of B's values on its graph,
-    // scaled; the transpose kept while the bonds and B_f do not change.
-    copy_values(scaled_coupling_, *coupling_s_, build);
-    scaled_coupling_->rightScale(*inverse_mass_);
-    const auto& flow = *joint_flow_.matrix();
-    projection_.update(build, *scaled_coupling_, false, *coupling_t_, false);
-    projection_.matrix()->rightScale(*sigma_);
-    storage_.update(build, storage);
-    rest_.update(build, dt * dt, *projection_.matrix(), 1.0, *storage_.matrix());
-    static_.update(build, dt, flow, 1.0, *rest_.matrix());
-    // The pressure increment is S x + c (x the solve's unknowns, c the held and lagged image
-    // increments). S_H: the images follow their mirrors' increments (odd or even), for the flow;
-    // S_P: they do not, for the skeleton's response within the step. An image's pressure reaches
-    // the skeleton in the next step's forces, as a held pressure does (measured: with the
-    // images' increments in the projection too (before the pressure stabilization), Terzaghi's
-    // mirrored column with incompressible or stiff water (K_w / phi = 100 M) and slow consolidation
-    // grew without bound: the image's force on the layer's skeleton, -p(mirror), answers the body's
-    // compression within the same solve, a coupling no water balance books). The system is
-    // R (dt V H S_H + (dt^2 P + V C) S_P + N S_H) + D_c, N the network's rows of the step: R keeps
-    // the free rows, D_c puts the mean free diagonal on the others. A fracture pressure is free
-    // unless held, and has no image. A point that may be free has its entry in S_H and S_P
-    // (1 where free, else 0: the graphs do not follow the values).
-    if (build)
-      keep_ = Teuchos::rcp(new TpetraVector(joint_));
-    TpetraVector diag(joint_), other(joint_);
-    static_.matrix()->getLocalDiagCopy(diag);
-    // A free point whose row is empty (it lost all its bonds, and its water has no storage:
-    // incompressible) keeps its pressure: dp = 0, a row of the mean diagonal.
-    double sum[2] = {0, 0};
-    solved_.assign(n + m, 0);
-    GlobalRows srows(n + m), frows(n + m);
-    {
-      auto kv = keep_->getLocalViewHost(Tpetra::Access::OverwriteAll);
-      auto dv = diag.getLocalViewHost(Tpetra::Access::ReadOnly);
-      for (std::size_t i = 0; i < n + m; ++i) {
-        const bool bulk = i < n;
-        const GlobalId g = bulk ? p.gid(i) : offset_ + p.gid(crack.point[i - n]);
-        srows[i].first = frows[i].first = g;
-        const bool may = bulk ? roles_[i] == PressureRole::Free : !crack.held[i - n];
-        const bool free = may && (!bulk || dv(i, 0) > 0);
-        solved_[i] = free ? 1 : 0;
-        kv(i, 0) = free ? 1.0 : 0.0;
-        if (may) {
-          srows[i].second.push_back({g, free ? 1.0 : 0.0});
-          frows[i].second.push_back({g, free ? 1.0 : 0.0});
-          if (bulk && free) {
-            sum[0] += dv(i, 0);
-            sum[1] += 1;
-          }
-        } else if (bulk &&
-                   (roles_[i] == PressureRole::OddImage || roles_[i] == PressureRole::EvenImage)) {
-          srows[i].second.push_back(
-              {p.gid(images_[i]), roles_[i] == PressureRole::OddImage ? -1.0 : 1.0});
-        }
-      }
-    }
-    MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPI_DOUBLE, MPI_SUM, comm_);
-    const double mean = sum[1] > 0 && sum[0] > 0 ? sum[0] / sum[1] : 1.0;
-    {
-      auto ov = other.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (std::size_t i = 0; i < n + m; ++i)
-        ov(i, 0) = solved_[i] ? 0.0 : mean;
-    }
-    if (build) {
-      s_h_.build(nullptr, joint_, srows, joint_, joint_);
-      s_p_.build(nullptr, joint_, frows, joint_, joint_);
-    } else {
-      s_h_.fill(nullptr, srows);
-      s_p_.fill(nullptr, frows);
-    }
-    // Without images S_H = S_P = diag(keep) (1 on the free rows, 0 on the others), so
-    // R (dt V H S_H + (dt^2 P + V C) S_P) is static_ scaled by keep on both sides: no products.
-    Teuchos::RCP<CrsMatrix> ras;
-    if (!images_any_) {
-      copy_values(scaled_static_, *static_.matrix(), build);
-      scaled_static_->rightScale(*keep_);
-      ras = scaled_static_;
-    } else {
-      flow_s_.update(build, flow, false, *s_h_.matrix(), false);
-      rest_s_.update(build, *rest_.matrix(), false, *s_p_.matrix(), false);
-      ras_.update(build, dt, *flow_s_.matrix(), 1.0, *rest_s_.matrix());
-      ras = ras_.matrix();
-    }
-    ras->leftScale(*keep_);
-    other_.update(build, other);
-    composed_.update(build, 1.0, *ras, 1.0, *other_.matrix());
-    if (build)
-      system_ = Teuchos::null;
-    dt_ = dt;
-    stale_ = false;
-    ++assemblies_;
-  }
+                const SkeletonState& sk, const CrackBlock& crack);
 
   Discretization<Dim>& disc_;
   bool images_any_;  // image points on some rank (the system is not symmetric)
@@ -742,6 +316,9 @@ class PressureProjection {
   bool stale_ = true;
   long long assemblies_ = 0;
 };
+
+extern template class PressureProjection<2>;
+extern template class PressureProjection<3>;
 
 }  // namespace mupm
 

@@ -12,7 +12,7 @@
 // Bond breakage is a step of its own between the mechanics' forces at t + dt and its velocity
 // update: the energy criterion (Algorithm 4) on the step's bond energies, then the J criterion
 // (include/mupm/solvers/j_integral.hpp, Algorithm 3); the damage and the flow of the new bond
-// set follow the mechanics (after_mechanics), then the crack's aperture.
+// set follow the mechanics (damage_step), then the crack's aperture (crack_step).
 #ifndef MUPM_STEP_SEQUENCE_HPP
 #define MUPM_STEP_SEQUENCE_HPP
 
@@ -48,7 +48,8 @@ struct StepSequence {
       fluid->project(t, dt, *skeleton);
       skeleton->finish_forces(t, dt);
       skeleton->complete(t, dt, breakage(t + dt));
-      after_mechanics();
+      damage_step();
+      crack_step();
       fluid->finish_projection(dt);
       mechanics->update_density();
       return;
@@ -60,32 +61,38 @@ struct StepSequence {
       mechanics->step_to_forces(t, dt);
       mechanics->complete_step(t, dt, breakage(t + dt));
     }
-    after_mechanics();
+    damage_step();
+    crack_step();
     // Without mechanics the interval is this step's [t, t + dt] (fluid_every is 1).
     if (fluid && !fluid_first && (step + 1) % fluid_every == 0)
       advance_fluid(mechanics ? t + dt - interval : t, interval);
   }
 
  private:
-  // The step's bond breakage at its end time t_end: the bonds broken on this rank and the energy
-  // they released (the energy criterion's; the J criterion's release no bond energy).
+  // The step's bond breakage at its end time t_end: the energy criterion, then the J
+  // criterion; the bonds broken on this rank and the energy they released (the energy
+  // criterion's; the J criterion's release no bond energy).
   Breakage breakage(double t_end) {
     Breakage b = mechanics->energy_breakage();
     if (j_criterion)
-      b.bonds += j_criterion->advance(t_end).bonds;
+      b.bonds += j_criterion_step(t_end).bonds;
     return b;
   }
-  void after_mechanics() {
-    // Bonds broke in the mechanics step: the damage changes (the pre-cracks' is computed at
-    // the start), and so does the fluid's flow of the current pressure (K^-1 and the families).
+  Breakage j_criterion_step(double t_end) { return j_criterion->advance(t_end); }
+  // Bonds broke in the mechanics step: the damage changes (the pre-cracks' is computed at the
+  // start), and so does the fluid's flow of the current pressure (K^-1 and the families).
+  void damage_step() {
     if (damage && mechanics && mechanics->broken_pairs() != damage_seen) {
       damage->update();
       if (fluid && mechanics->broken_pairs() > 0)
         fluid->bonds_changed();
       damage_seen = mechanics->broken_pairs();
     }
-    // The crack opens with the displacement: the aperture of the points with broken bonds
-    // (pre-cracks included) every step (the solid left u current on the ghosts).
+  }
+  // The crack opens with the displacement: the aperture of the points with broken bonds
+  // (pre-cracks included) every step (the solid left u current on the ghosts), which the crack
+  // water's storage and flow take (include/mupm/solvers/fracture_flow.hpp).
+  void crack_step() {
     if (damage && mechanics)
       damage->update_aperture();
   }

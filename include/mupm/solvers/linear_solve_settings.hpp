@@ -1,0 +1,46 @@
+// The settings of a distributed sparse linear solve (include/mupm/solvers/linear_solve.hpp), apart
+// so that the input model and the solvers' declarations take them without Tpetra's headers.
+#ifndef MUPM_SOLVERS_LINEAR_SOLVE_SETTINGS_HPP
+#define MUPM_SOLVERS_LINEAR_SOLVE_SETTINGS_HPP
+
+#include <string>
+
+namespace mupm {
+
+struct LinearSolveSettings {
+  // "GMRES" | "CG": CG needs a symmetric positive definite matrix and preconditioner (ILU(k) of
+  // a symmetric matrix is L D L^T up to round-off); it keeps no basis, so an iteration costs a
+  // product, a preconditioner apply and three reductions, GMRES's also an orthogonalization
+  // against every earlier vector.
+  std::string method = "GMRES";
+  std::string preconditioner = "ILU";  // "ILU" (Ifpack2 RILUK) | "Jacobi" | "None"
+  int fill_level = 0;                  // ILU(k)
+  double tolerance = 1e-11;            // ||b - A x|| / the largest ||b|| so far
+  int max_iterations = 1000;
+  int restart = 100;  // GMRES restart length (not used by CG)
+  // refresh() computes the preconditioner's numeric part on every refresh_interval-th call
+  // since the last set-up, and keeps the factors of the earlier values in between: the Krylov
+  // method still solves the current matrix to the tolerance (any fixed symmetric positive
+  // definite preconditioner serves CG), only its iteration count depends on how close the
+  // factors are. 1: every call.
+  int refresh_interval = 1;
+  // CG only, > 0: Belos' recycling CG (RCG, Parks et al. 2006) with a recycle space of this many
+  // vectors, approximate eigenvectors of the preconditioned matrix's smallest eigenvalues
+  // gathered over the solves and deflated from every later one. A sequence of systems with
+  // the same or slowly changing matrix (the projection's, step after step) then converges in
+  // fewer iterations, for `recycle` products and preconditioner applies per solve (A U of the
+  // current matrix) and a small eigenproblem every 25 iterations. The space is dropped with
+  // every new matrix and at renew(), so that a restart, which starts without one, continues
+  // the run bit for bit. 0: CG (measured: perf/README.md).
+  int recycle = 0;
+  // > 0: the ILU is of A without its entries |a_ij| < drop_tolerance sqrt(|a_ii a_jj|) (each
+  // added to the diagonal, so that the preconditioner stays symmetric positive definite; the
+  // Krylov method still solves A). The projection's matrix is two horizons wide and its far
+  // entries small: its ILU(0) then costs a quarter of one of A's per apply, for more
+  // iterations (perf/README.md).
+  double drop_tolerance = 0;
+};
+
+}  // namespace mupm
+
+#endif
