@@ -162,7 +162,7 @@ void BM_SolidForcesWithBreakage(benchmark::State& state) {
 
 // The same body with one-horizon boundary layers on both y faces, every point of them slaved (a
 // clamp: all components held, energy-free), for the fold of their forces onto their mirrors
-// (kernels/boundary_conditions.hpp; SolidSolver::fold_layers): zero the buffer, pack, the Tpetra
+// (kernels/boundary_conditions.hpp; SolidBoundary::fold): zero the buffer, pack, the Tpetra
 // export that adds ghost rows into their owners (on one rank its fixed cost and the copies of all
 // rows in and out), add. What a step with slaved layers adds to BM_SolidForces.
 template <int Dim>

@@ -1,5 +1,9 @@
 #include "mupm/mesh/distribution.hpp"
 
+#include <Tpetra_Import.hpp>
+#include <Tpetra_Map.hpp>
+#include <Tpetra_MultiVector.hpp>
+
 #include <Teuchos_ArrayView.hpp>
 #include <Tpetra_Access.hpp>
 #include <algorithm>
@@ -115,6 +119,10 @@ void Distribution::add_to_owners(const Vectors& buf) {
         });
   }
   Kokkos::fence();
+}
+
+GlobalId Distribution::n_global() const {
+  return static_cast<GlobalId>(owned_map_->getGlobalNumElements());
 }
 
 }  // namespace mupm

@@ -17,11 +17,13 @@ double SolidEnergy::balance() const {
   return b;
 }
 
+// The supplied terms by magnitude, the held and dissipated ones as they are (a negative fracture
+// energy, which the kinetic shift's jump can make, is not the scale).
 double SolidEnergy::scale() const {
   double s = std::max(std::abs(internal), kinetic);
   for (const auto& t : kSolidLedger)
     if (t.side != 0)
-      s = std::max(s, std::abs(this->*t.value));
+      s = std::max(s, t.side < 0 ? std::abs(this->*t.value) : this->*t.value);
   return s;
 }
 

@@ -486,8 +486,8 @@ void SolidSolver<Dim, Law>::bands(double& angle, double& width) const {
                 g.origin[1] + 0.5 * g.counts[1] * g.dx, sum, max, angle, width);
 }
 
-// Such an evaluation sees the pressure the fluid has updated since the step's forces, and
-// where the return depends on it (plane stress with pore water,
+// An evaluation between two steps sees the pressure the fluid has updated since the step's
+// forces, and where the plastic return depends on it (plane stress with pore water,
 // laws/micropolar_drucker_prager.hpp) it would change the state the next step commits (a
 // restart then differed from the straight run by 1e-7 after one step).
 template <int Dim, class Law>

@@ -1,8 +1,9 @@
 // SolidSolver::estimate_stable_dt (include/mupm/solvers/solid_solver.hpp): the largest stable
 // step of the undamped central difference, 2 / omega_max, with omega_max^2 the largest
 // eigenvalue of M^-1 K of the discrete operator, by power iteration
-// (include/mupm/solvers/power_iteration.hpp) on an iterate of its own: the points' fields are
-// not touched.
+// (include/mupm/solvers/power_iteration.hpp) on an iterate of its own: of the points' fields
+// only the stress pass 1 writes changes, and the forces of the points' state, evaluated again
+// at the end, write it back.
 #include "mupm/core/timers.hpp"
 #include "mupm/solvers/power_iteration.hpp"
 #include "mupm/solvers/solid_solver.hpp"

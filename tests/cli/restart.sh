@@ -153,7 +153,7 @@ solve=1
 check fracture-flow tests/cli/fracture_small.xml 440 23 "$flow_edit"
 # The same with a drained boundary layer at the notch's face (-x) that the crack runs into, its
 # fracture points held by a mirrored Fracture Pressure (2 g - q, q relaxed from the step's start
-# and rebuilt from the checkpointed p_f: solvers/fracture_flow.hpp, assemble).
+# and rebuilt from the checkpointed p_f: src/solvers/fracture_flow.cpp, assemble).
 check fracture-flow-mirrored tests/cli/fracture_small.xml 440 25 "s|value=\"\{-y, \+y\}\"|value=\"{-x, -y, +y}\"|; $flow_edit; s|<ParameterList name=\"Boundary Conditions\">|<ParameterList name=\"Boundary Conditions\"><ParameterList name=\"drained\"><Parameter name=\"Type\" type=\"string\" value=\"Pore Pressure\"/><Parameter name=\"Region\" type=\"string\" value=\"Layer -x\"/></ParameterList><ParameterList name=\"mouth pressure\"><Parameter name=\"Type\" type=\"string\" value=\"Fracture Pressure\"/><Parameter name=\"Region\" type=\"string\" value=\"Layer -x\"/><Parameter name=\"Value\" type=\"double\" value=\"1e6\"/><Parameter name=\"Boundary Layer Values\" type=\"string\" value=\"Mirrored\"/></ParameterList>|"
 # Drucker-Prager plasticity (Example 3 at 16 x 32, dt = 1.75e-5 s): restarted at step 3700
 # (t = 0.065 s), as the bands soften, with the plastic state, the step's start state and the

@@ -317,7 +317,7 @@ double layered_slot_gradient(bool mirrored, double& face_value) {
   fluid.enable_fracture_flow(flow_params());
   fluid.initialize(0.0, false);
   // Each step is far beyond the slot's diffusion time; the relaxed mirror value settles by a
-  // factor of at most 1/2 per step (solvers/fracture_flow.hpp, assemble): 80 steps reach
+  // factor of at most 1/2 per step (src/solvers/fracture_flow.cpp, assemble): 80 steps reach
   // round-off.
   const double dt = 1e-3;
   const double mass0 = fluid.fluid_mass() + fluid.fracture_flow()->mass();

@@ -4,6 +4,8 @@
 #ifndef MUPM_CHECKPOINT_HPP
 #define MUPM_CHECKPOINT_HPP
 
+#include <mpi.h>
+
 #include <exception>
 #include <string>
 #include <utility>

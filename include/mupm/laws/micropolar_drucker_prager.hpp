@@ -376,7 +376,7 @@ KOKKOS_INLINE_FUNCTION double drucker_prager_return_plane_stress(
 // (Points::plastic_strain, ...), which every evaluation of pass 1 recomputes from the start
 // state and the current strain. The solver commits (current -> start) at the start of each step,
 // before its forces: the other evaluations between two steps (after a breakage, the stable-step
-// estimate's restoring one, a restart's first one) start from the same state as the step's own,
+// estimate's closing one, a restart's first one) start from the same state as the step's own,
 // so they reproduce or replace its result, never add plastic flow twice, and a restart needs
 // nothing but the checkpoint. The stable-step power iteration uses the elastic law (the elastic
 // stiffness bounds the tangent one).

@@ -5,11 +5,14 @@
 #ifndef MUPM_DISTRIBUTION_HPP
 #define MUPM_DISTRIBUTION_HPP
 
+// Tpetra's map, import and multivector declared only: their headers are the heaviest a file of
+// mupm parses, and only src/mesh/distribution.cpp and the pressure solves use them (a file that
+// calls into owned_map() includes <Tpetra_Map.hpp> itself).
 #include <Teuchos_Comm.hpp>
 #include <Teuchos_RCP.hpp>
-#include <Tpetra_Import.hpp>
-#include <Tpetra_Map.hpp>
-#include <Tpetra_MultiVector.hpp>
+#include <Tpetra_Import_fwd.hpp>
+#include <Tpetra_Map_fwd.hpp>
+#include <Tpetra_MultiVector_fwd.hpp>
 #include <map>
 #include <vector>
 
@@ -33,7 +36,7 @@ class Distribution {
   const Teuchos::RCP<const Map>& overlap_map() const { return overlap_map_; }
   std::size_t n_owned() const { return n_owned_; }
   std::size_t n_ghost() const { return n_ghost_; }
-  GlobalId n_global() const { return static_cast<GlobalId>(owned_map_->getGlobalNumElements()); }
+  GlobalId n_global() const;
 
   // Copies the owned rows of every field (each [n_owned + n_ghost][ncomp]) into the ghost rows
   // of the other ranks that need them. Fields of one call travel together in one MultiVector.

@@ -163,7 +163,8 @@
 // no transpose. The preconditioner's factors then follow LinearSolve::refresh (kept up to
 // Preconditioner Refresh Interval steps, renewed after each checkpoint). The solve is CG where A
 // is symmetric (no image points; krylov below), GMRES otherwise, each with ILU(k) of A less its
-// small (far) entries: Pressure Solve's Drop Tolerance (include/mupm/solvers/linear_solve.hpp).
+// small (far) entries: Pressure Solve's Drop Tolerance
+// (include/mupm/solvers/linear_solve_settings.hpp).
 #ifndef MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 #define MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 

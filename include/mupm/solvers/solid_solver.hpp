@@ -155,7 +155,7 @@ class SolidSolver : public Mechanics, public Skeleton {
   void commit_plastic();
   void save_positions();
   void increments();
-  // This rank's damping power, pore power (with eq 17's) and strain energy (finish_forces).
+  // This rank's damping power and pore power (with eq 17's) of the step (finish_forces).
   double damping_power() const;
   double pore_power() const;
   // band_angle [deg] and band_width [m] (include/mupm/kernels/shear_bands.hpp), collective.
