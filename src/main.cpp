@@ -77,7 +77,8 @@ int without_kokkos(const std::string& mode, const std::string& path, int argc, c
           std::cout << "mupm: " << path << " is valid; it needs about "
                     << m.bytes_per_rank / (1 << 20) << " MiB per rank on " << comm->getSize()
                     << " rank(s) (" << m.available_per_rank / (1 << 20)
-                    << " MiB available per rank)\n";
+                    << " MiB available per rank); its point fields take " << m.point_field_bytes
+                    << " bytes per point\n";
       } catch (const mupm::InputError& e) {
         if (root)
           std::cerr << "mupm: input error in " << path << ":\n" << e.what() << "\n";

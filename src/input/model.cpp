@@ -79,12 +79,6 @@ const Options<PressureIntegration>& pressure_integration_options() {
                                {"Semi-Implicit", PressureIntegration::SemiImplicit}});
   return o;
 }
-const Options<ConstitutiveModel>& constitutive_model_options() {
-  static const Options<ConstitutiveModel> o(
-      "Model", {{"Micropolar Elastic", ConstitutiveModel::MicropolarElastic},
-                {"Micropolar Drucker-Prager", ConstitutiveModel::MicropolarDruckerPrager}});
-  return o;
-}
 const Options<StabilizationModulus>& stabilization_modulus_options() {
   static const Options<StabilizationModulus> o(
       "Stabilization Modulus", {{"Automatic", StabilizationModulus::Automatic},
@@ -377,6 +371,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
   r.fields.assign(fields.begin(), fields.end());
   r.field_interval = output.get<int>("Field Interval");
   r.second_order_window = output.get<int>("Second-Order Work Window");
+  r.field_groups = point_field_groups(input);
   r.series_interval = output.get<int>("Time Series Interval");
   r.checkpoint_interval = output.get<int>("Checkpoint Interval");
   r.checkpoint_at_end = output.get<bool>("Checkpoint At End");

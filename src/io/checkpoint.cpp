@@ -199,6 +199,7 @@ void write_checkpoint(const std::string& path, const Discretization<Dim>& disc, 
     file.write_attribute("time", time);
     file.write_attribute("spacing", disc.grid.dx);
     file.write_attribute("horizon", disc.grid.horizon);
+    file.write_attribute("point_field_groups", static_cast<long long>(disc.points.groups));
     for (const auto& f : fixed)
       file.write_attribute(fixed_attribute(f), f.value);
     file.write_global("output_history", output_history);
@@ -250,7 +251,14 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
       throw CollectiveError(where + "is damaged: " + e.what() + ".");
     }
   }
+  // A field group the writing run did not allocate (one that only this run's Output->Fields
+  // asks for) has no datasets: its fields stay zero, as the writer's were.
+  const unsigned written = file.has_attribute("point_field_groups")
+                               ? unsigned(file.read_attribute_int("point_field_groups"))
+                               : kAllGroups;
   for_each_checkpointed(disc.points, [&](const auto& view, const FieldSpec& s) {
+    if (!(s.group & written))
+      return;
     std::vector<typename std::decay_t<decltype(view)>::value_type> rows(n * std::size_t(s.ncomp));
     file.read_points(std::string("points/") + s.name, gids, s.ncomp, rows.data());
     io::set_owned_rows(view, n, rows);

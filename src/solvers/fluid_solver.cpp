@@ -22,6 +22,7 @@ FluidSolver<Dim>::FluidSolver(Discretization<Dim>& disc, const FluidParams& prm,
                              "' mirrors its layer, but the grid was built without mirrors "
                              "(GridSpec::mirrored_layers)");
   auto& p = disc_.points;
+  p.require(kGroupPoreWater, "FluidSolver");
   st_.allocate(p.size(), p.n_owned);
   source_ = Scalars("mupm::fluid_source", p.n_owned);
   supply_ = Scalars("mupm::fluid_supply", p.n_owned);
@@ -31,6 +32,7 @@ FluidSolver<Dim>::FluidSolver(Discretization<Dim>& disc, const FluidParams& prm,
 
 template <int Dim>
 void FluidSolver<Dim>::enable_fracture_flow(const FractureParams& prm) {
+  disc_.points.require(kGroupCrackWater, "FractureFlow");
   fracture_ = std::make_unique<FractureFlow<Dim>>(disc_, prm_, prm, all_bcs_, comm_);
   if (semi_implicit_)
     fracture_->set_implicit();

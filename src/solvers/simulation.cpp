@@ -313,9 +313,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
     settings.fracture = model.fracture;
     settings.semi_implicit = model.run.semi_implicit;
     settings.fluid = has_fluid(physics);
-    const auto& f = model.run.fields;
-    if (model.constitutive_model == ConstitutiveModel::MicropolarDruckerPrager ||
-        std::find(f.begin(), f.end(), "second_order_work") != f.end())
+    if (model.run.field_groups & kGroupSecondOrderWork)  // point_field_groups
       settings.second_order_window = model.run.second_order_window > 0
                                          ? model.run.second_order_window
                                          : model.run.field_interval;
@@ -343,7 +341,7 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
   }
   if (ph.fluid && model.fracture.flow)
     ph.fluid->enable_fracture_flow(model.fracture);
-  if (ph.fluid && model.run.semi_implicit) {  // Hydro-Mechanical (src/input/input.cpp)
+  if (ph.fluid && model.run.semi_implicit) {  // Hydro-Mechanical (src/input/modules/solver.cpp)
     ph.fluid->enable_semi_implicit(model.run.pressure_solve);
     ph.sequence.skeleton = dynamic_cast<Skeleton*>(ph.mechanics.get());
     if (!ph.sequence.skeleton)
@@ -373,7 +371,7 @@ long long report_discretization(const Discretization<Dim>& disc, const Teuchos::
         << " ghost copies), " << counts[0] << " bonds, dx = " << g.dx
         << " m, horizon = " << g.horizon << " m (" << g.horizon / g.dx << " dx)\n"
         << "mupm: " << comm.getSize() << " rank(s) x " << ExecSpace().concurrency() << " "
-        << ExecSpace::name() << " thread(s); " << Points<Dim>::bytes_per_point()
+        << ExecSpace::name() << " thread(s); " << Points<Dim>::bytes_per_point(disc.points.groups)
         << " bytes per point, " << Bonds::bytes_per_bond(pair_width) << " bytes per bond\n";
   return counts[0];
 }
@@ -943,7 +941,7 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
       out << "mupm: WARNING: " << w << ".\n";
   warn_placement(mpi, int(ExecSpace().concurrency()), out);
 
-  Discretization<Dim> disc = discretize(comm, model.grid);
+  Discretization<Dim> disc = discretize(comm, model.grid, model.run.field_groups);
   Points<Dim>& pts = disc.points;
   const int pair_width = model.fracture.criterion == BondBreaking::Energy ? Dim + kRotDim<Dim> : 0;
   const long long n_bonds = report_discretization(disc, *comm, pair_width, out);

@@ -25,6 +25,12 @@ SolidSolver<Dim, Law>::SolidSolver(Discretization<Dim>& disc, const SolidParams&
   if constexpr (std::is_same_v<Law, MicropolarElastic>)
     law_ = prm.law;
   auto& p = disc_.points;
+  if constexpr (Law::plastic)
+    p.require(kGroupPlastic, "SolidSolver's plastic law");
+  if (set_.second_order_window > 0)
+    p.require(kGroupSecondOrderWork, "SolidSolver's second-order work");
+  if (set_.fracture.flow)
+    p.require(kGroupCrackWater, "SolidSolver's crack water force");
   st_.allocate(p.size(), p.n_owned);
   rho_ = Scalars("mupm::density", p.n_owned);
   inertia_ = Scalars("mupm::micro_inertia", p.n_owned);

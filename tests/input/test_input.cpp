@@ -362,6 +362,76 @@ TEST(Input, PlaneStress) {
   validate_input(*parse_input(xml(kOk + stress, wet_dp_si)));
 }
 
+// The point fields a run allocates follow from its modules: the pore water's with a fluid, the
+// crack water's with Fracture Flow, the plastic state and the second-order work with
+// Drucker-Prager, and the group of every field Output->Fields names.
+TEST(Input, PointFieldGroups) {
+  auto groups = [](const std::string& discretization, const std::string& rest) {
+    auto pl = parse_input(xml(discretization, rest));
+    validate_input(*pl);
+    EXPECT_EQ(model_from_input<2>(*pl).run.field_groups, point_field_groups(*pl));
+    return point_field_groups(*pl);
+  };
+  auto fields = [](const std::string& list) {
+    return "<ParameterList name=\"Output\"><Parameter name=\"Fields\" type=\"Array(string)\" "
+           "value=\"{" +
+           list + "}\"/></ParameterList>";
+  };
+  auto solver = [](const std::string& physics) {
+    return "<ParameterList name=\"Solver\"><Parameter name=\"Physics\" type=\"string\" "
+           "value=\"" +
+           physics +
+           "\"/></ParameterList><ParameterList name=\"Fluid\"><Parameter name=\"Hydraulic "
+           "Conductivity\" type=\"double\" value=\"1e-5\"/></ParameterList>"
+           "<ParameterList name=\"Materials\">"
+           "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+           "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+           "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+           "<Parameter name=\"Porosity\" type=\"double\" value=\"0.3\"/></ParameterList>";
+  };
+  const std::string flow =
+      "<ParameterList name=\"Fracture\"><Parameter name=\"Fracture Flow\" type=\"bool\" "
+      "value=\"true\"/></ParameterList>";
+  const std::string dp =
+      "<ParameterList name=\"Materials\">"
+      "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+      "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+      "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+      "<Parameter name=\"Model\" type=\"string\" value=\"Micropolar Drucker-Prager\"/>"
+      "<Parameter name=\"Cohesion\" type=\"double\" value=\"1e4\"/>"
+      "</ParameterList>";
+  EXPECT_EQ(groups(kOk, ""), unsigned(kGroupCore));
+  EXPECT_EQ(groups(kOk, solver("Pore Fluid")), unsigned(kGroupCore | kGroupPoreWater));
+  EXPECT_EQ(groups(kOk, solver("Hydro-Mechanical")), unsigned(kGroupCore | kGroupPoreWater));
+  EXPECT_EQ(groups(kOk, solver("Hydro-Mechanical") + flow),
+            unsigned(kGroupCore | kGroupPoreWater | kGroupCrackWater));
+  EXPECT_EQ(groups(kOk, dp), unsigned(kGroupCore | kGroupPlastic | kGroupSecondOrderWork));
+  EXPECT_EQ(groups(kOk, fields("displacement, plastic_strain")),
+            unsigned(kGroupCore | kGroupPlastic));
+  EXPECT_EQ(groups(kOk, fields("second_order_work")), unsigned(kGroupCore | kGroupSecondOrderWork));
+  EXPECT_EQ(groups(kOk, fields("fracture_pressure, darcy_flux")),
+            unsigned(kGroupCore | kGroupPoreWater | kGroupCrackWater));
+  // Points of the core group alone: the others' fields are empty and not visited, and the bytes
+  // per point are the sum of the core fields' sizes.
+  Points<2> pts(5, 2, kGroupCore);
+  std::size_t bytes = 0;
+  int visited = 0;
+  pts.for_each_field([&](const auto& view, const FieldSpec& s) {
+    EXPECT_EQ(s.group, unsigned(kGroupCore)) << s.name;
+    EXPECT_EQ(view.extent(0), 7u) << s.name;
+    bytes += sizeof(typename std::decay_t<decltype(view)>::value_type) * std::size_t(s.ncomp);
+    ++visited;
+  });
+  EXPECT_EQ(bytes, Points<2>::bytes_per_point(kGroupCore));
+  EXPECT_LT(visited, int(Points<2>::specs().size()));
+  EXPECT_EQ(pts.plastic_strain.extent(0), 0u);
+  EXPECT_EQ(pts.pf.extent(0), 0u);
+  EXPECT_EQ(pts.darcy_flux.extent(0), 0u);
+  EXPECT_EQ(pts.second_order_work.extent(0), 0u);
+  EXPECT_THROW(pts.require(kGroupPlastic, "test"), std::logic_error);
+  EXPECT_NO_THROW(pts.require(kGroupCore, "test"));
+}
+
 TEST(Input, MalformedXml) {
   EXPECT_THROW(parse_input("<ParameterList name=\"mupm\"><Parameter name="), InputError);
 }

@@ -150,6 +150,68 @@ TEST(Checkpoint, MismatchIsReportedOnEveryRank) {
     std::remove(path.c_str());
 }
 
+// A run writes the datasets of the field groups it allocated (include/mupm/data/fields.hpp). A
+// restart that allocates more groups (its Output->Fields names more fields) finds the others
+// zero, as the writer's were; one that allocates fewer reads those it has.
+TEST(Checkpoint, FieldGroupsTheWriterDidNotAllocate) {
+  const auto g = test::box<2>({8, 7}, 3.015);
+  const auto specs = Points<2>::specs();
+  // The value of field `name` at gid, keyed by the field's place in the whole registry.
+  auto expected = [&](const char* name, GlobalId gid, int c) {
+    int k = 0;
+    while (std::string(specs[std::size_t(k)].name) != name)
+      ++k;
+    return value(gid, k, c);
+  };
+  auto each_double = [](const Points<2>& p, auto&& f) {
+    p.for_each_field([&](const auto& view, const FieldSpec& s) {
+      using V = std::decay_t<decltype(view)>;
+      if constexpr (std::is_same_v<typename V::value_type, double>)
+        if (s.has(kCheckpoint)) {
+          if constexpr (V::rank == 1)
+            f(as_vectors(view), s);
+          else
+            f(Vectors(view), s);
+        }
+    });
+  };
+  const unsigned written = kGroupCore | kGroupPoreWater;
+  for (const unsigned read : {unsigned(kAllGroups), unsigned(kGroupCore)}) {
+    const std::string path = unique_path("groups");
+    {
+      auto disc = discretize(test::world(), g, written);
+      auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.gid);
+      each_double(disc.points, [&](Vectors v, const FieldSpec& s) {
+        auto h = Kokkos::create_mirror_view(v);
+        for (std::size_t i = 0; i < disc.points.n_owned; ++i)
+          for (std::size_t c = 0; c < h.extent(1); ++c)
+            h(i, c) = expected(s.name, gid(i), int(c));
+        Kokkos::deep_copy(v, h);
+      });
+      write_checkpoint(path, disc, 7, 1e-3, {});
+    }
+    auto disc = discretize(test::world(), g, read);
+    long long step = 0;
+    double time = 0;
+    std::vector<double> history;
+    read_checkpoint(path, disc, step, time, history);
+    auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), disc.points.gid);
+    int zero = 0;
+    each_double(disc.points, [&](Vectors v, const FieldSpec& s) {
+      auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+      zero += (s.group & written) ? 0 : 1;
+      for (std::size_t i = 0; i < disc.points.n_owned; ++i)
+        for (std::size_t c = 0; c < h.extent(1); ++c)
+          ASSERT_EQ(h(i, c), (s.group & written) ? expected(s.name, gid(i), int(c)) : 0.0)
+              << s.name << " at gid " << gid(i);
+    });
+    EXPECT_EQ(zero > 0, read == unsigned(kAllGroups));
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (test::world()->getRank() == 0)
+      std::remove(path.c_str());
+  }
+}
+
 // Restart globals travel by name; a missing one and a checkpoint of another layout version are
 // clear errors on every rank.
 TEST(Checkpoint, NamedGlobalsAndVersion) {

@@ -17,12 +17,25 @@ enum FieldTrait : unsigned {
   kFinite = 1u << 4,      // checked for NaN and Inf after every step (Diagnostics->Check Finite)
 };
 
+// Groups of point fields: a run allocates the groups its modules use (Points::groups,
+// point_field_groups in src/input/input.cpp, from the input modules) and the fields of any group
+// Output->Fields names.
+enum FieldGroup : unsigned {
+  kGroupCore = 1u << 0,       // every run: kinematics, stress, damage, the pressure the solid reads
+  kGroupPoreWater = 1u << 1,  // the pore fluid's own state (Solver->Physics with a fluid)
+  kGroupCrackWater = 1u << 2,  // the crack water (Fracture->Fracture Flow)
+  kGroupPlastic = 1u << 3,     // the plastic state (Materials->Model = Micropolar Drucker-Prager)
+  kGroupSecondOrderWork = 1u << 4,  // second-order work and its window's start (eq 42)
+  kAllGroups = (1u << 5) - 1,
+};
+
 struct FieldSpec {
   const char* name;  // output and checkpoint dataset name (snake_case)
   int ncomp;         // components per point (per bond for bond fields)
   unsigned traits;
   // Name under which Initial Conditions->NAME->Field sets it, or nullptr.
   const char* initial_condition = nullptr;
+  unsigned group = kGroupCore;  // FieldGroup: allocated only in runs that use it
   bool has(unsigned t) const { return (traits & t) == t; }
 };
 

@@ -5,11 +5,13 @@
 // component count and its traits (include/mupm/data/fields.hpp). Allocation, the bytes per
 // point, the ghost exchanges, the checkpoint, the output list and its validator, the
 // initial-condition names, the NaN check and the README's field list (checked by a test) all
-// follow from it. A new field is one member below and one line in for_each_field.
+// follow from it. A new field is one member below and one line in for_each_field. Each field
+// belongs to a FieldGroup; a run allocates only the groups its modules use.
 #ifndef MUPM_POINTS_HPP
 #define MUPM_POINTS_HPP
 
 #include <cstddef>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -46,6 +48,9 @@ struct Points {
 
   std::size_t n_owned = 0;
   std::size_t n_ghost = 0;
+  // FieldGroup bits of the allocated fields: the registry's other fields stay empty Views, and
+  // for_each_field does not visit them.
+  unsigned groups = kAllGroups;
   std::size_t size() const { return n_owned + n_ghost; }
 
   // Constant per point: exchanged once.
@@ -104,8 +109,10 @@ struct Points {
   // The registry: f(view, spec) for every field, in this order (the checkpoint's and the
   // output list's). Traits: kConstant (sent to the ghosts once), kGhosted (refreshed on the
   // ghosts at a start and a restart), kCheckpoint, kOutput (selectable in Output->Fields),
-  // kFinite (checked for NaN/Inf every step); the last argument is the name under which an
-  // initial condition sets the field (Initial Conditions->NAME->Field), or nullptr.
+  // kFinite (checked for NaN/Inf every step); the fourth argument is the name under which
+  // an initial condition sets the field (Initial Conditions->NAME->Field), or nullptr; the fifth
+  // its FieldGroup (W pore water, C crack water, P plastic, S second-order work; else core). Only
+  // the fields of the allocated groups are visited.
   template <class F>
   void for_each_field(F&& f) {
     visit(*this, f);
@@ -116,19 +123,24 @@ struct Points {
   }
 
   Points() = default;
-  Points(std::size_t owned, std::size_t ghost) { allocate(owned, ghost); }
+  Points(std::size_t owned, std::size_t ghost, unsigned field_groups = kAllGroups) {
+    allocate(owned, ghost, field_groups);
+  }
 
-  void allocate(std::size_t owned, std::size_t ghost) {
+  void allocate(std::size_t owned, std::size_t ghost, unsigned field_groups = kAllGroups) {
     n_owned = owned;
     n_ghost = ghost;
+    groups = field_groups | kGroupCore;
     const std::size_t n = owned + ghost;
     for_each_field([n](auto& view, const FieldSpec& s) { allocate_field(view, s, n); });
   }
 
-  // Resident bytes of one point (all fields of the registry).
-  static std::size_t bytes_per_point() {
+  // Resident bytes of one point (the registry's fields of the given groups).
+  static std::size_t bytes_per_point(unsigned field_groups = kAllGroups) {
     std::size_t b = 0;
-    Points().for_each_field([&b](const auto& view, const FieldSpec& s) {
+    Points probe;
+    probe.groups = field_groups | kGroupCore;
+    probe.for_each_field([&b](const auto& view, const FieldSpec& s) {
       b += sizeof(typename std::decay_t<decltype(view)>::value_type) * std::size_t(s.ncomp);
     });
     return b;
@@ -152,7 +164,17 @@ struct Points {
     return out;
   }
 
-  // The specs alone (names, components, traits), e.g. for the input's validators.
+  // Throws std::logic_error unless the fields of `group` are allocated: a module's check that
+  // the run allocated what it uses (an empty View would be read out of bounds).
+  void require(unsigned group, const char* module) const {
+    if ((groups & group) != group)
+      throw std::logic_error(std::string(module) + " needs point fields that were not allocated (" +
+                             "FieldGroup " + std::to_string(group) +
+                             "; point_field_groups in src/input/input.cpp)");
+  }
+
+  // The specs alone (names, components, traits, groups) of every field, e.g. for the input's
+  // validators.
   static std::vector<FieldSpec> specs() {
     std::vector<FieldSpec> out;
     Points().for_each_field([&out](const auto&, const FieldSpec& s) { out.push_back(s); });
@@ -160,10 +182,16 @@ struct Points {
   }
 
  private:
-  template <class P, class F>
-  static void visit(P& p, F& f) {
+  template <class Pts, class F>
+  static void visit(Pts& p, F& fn) {
     constexpr int D = Dim, R = rot_dim;
     constexpr unsigned kState = kCheckpoint | kOutput;
+    constexpr unsigned W = kGroupPoreWater, C = kGroupCrackWater, P = kGroupPlastic,
+                       S = kGroupSecondOrderWork;
+    auto f = [&](auto& view, const FieldSpec& s) {
+      if (s.group & p.groups)
+        fn(view, s);
+    };
     // clang-format off
     f(p.gid,               FieldSpec{"global_id", 1, 0});
     f(p.x,                 FieldSpec{"coordinates", D, kConstant});
@@ -178,25 +206,25 @@ struct Points {
     f(p.omega,             FieldSpec{"micro_rotation_rate", R, kState | kFinite, "Micro-Rotation Rate"});
     f(p.alpha,             FieldSpec{"micro_rotation_acceleration", R, kCheckpoint | kFinite});
     f(p.p,                 FieldSpec{"pore_pressure", 1, kState | kGhosted | kFinite, "Pore Pressure"});
-    f(p.p_rate,            FieldSpec{"pore_pressure_rate", 1, kCheckpoint});
-    f(p.pf,                FieldSpec{"fracture_pressure", 1, kState | kGhosted | kFinite});
-    f(p.pf_rate,           FieldSpec{"fracture_pressure_rate", 1, kCheckpoint});
-    f(p.pf_saturation,     FieldSpec{"fracture_saturation", 1, kState | kGhosted});
-    f(p.pf_content,        FieldSpec{"fracture_fluid_content", 1, kState});
-    f(p.pf_aperture,       FieldSpec{"fracture_storage_aperture", 1, kCheckpoint});
-    f(p.pf_modulus,        FieldSpec{"fracture_undrained_modulus", 1, kCheckpoint});
-    f(p.pf_area,           FieldSpec{"fracture_face_area", 1, kCheckpoint});
+    f(p.p_rate,            FieldSpec{"pore_pressure_rate", 1, kCheckpoint, nullptr, W});
+    f(p.pf,                FieldSpec{"fracture_pressure", 1, kState | kGhosted | kFinite, nullptr, C});
+    f(p.pf_rate,           FieldSpec{"fracture_pressure_rate", 1, kCheckpoint, nullptr, C});
+    f(p.pf_saturation,     FieldSpec{"fracture_saturation", 1, kState | kGhosted, nullptr, C});
+    f(p.pf_content,        FieldSpec{"fracture_fluid_content", 1, kState, nullptr, C});
+    f(p.pf_aperture,       FieldSpec{"fracture_storage_aperture", 1, kCheckpoint, nullptr, C});
+    f(p.pf_modulus,        FieldSpec{"fracture_undrained_modulus", 1, kCheckpoint, nullptr, C});
+    f(p.pf_area,           FieldSpec{"fracture_face_area", 1, kCheckpoint, nullptr, C});
     f(p.porosity,          FieldSpec{"porosity", 1, kState, "Porosity"});
     f(p.saturation,        FieldSpec{"saturation", 1, kState, "Saturation"});
-    f(p.rel_perm,          FieldSpec{"relative_permeability", 1, kState});
-    f(p.darcy_flux,        FieldSpec{"darcy_flux", D, kState});
+    f(p.rel_perm,          FieldSpec{"relative_permeability", 1, kState, nullptr, W});
+    f(p.darcy_flux,        FieldSpec{"darcy_flux", D, kState, nullptr, W});
     f(p.vol_strain,        FieldSpec{"volumetric_strain", 1, kState});
     f(p.vol_strain_ref,    FieldSpec{"volumetric_strain_reference", 1, kCheckpoint});
-    f(p.fluid_content,     FieldSpec{"fluid_content", 1, kState});
+    f(p.fluid_content,     FieldSpec{"fluid_content", 1, kState, nullptr, W});
     f(p.solid_pressure,    FieldSpec{"solid_pressure", 1, kCheckpoint});
     f(p.applied_force,     FieldSpec{"applied_force", D, kCheckpoint});
     f(p.applied_moment,    FieldSpec{"applied_moment", R, kCheckpoint});
-    f(p.applied_crack_force, FieldSpec{"applied_crack_force", D, kCheckpoint});
+    f(p.applied_crack_force, FieldSpec{"applied_crack_force", D, kCheckpoint, nullptr, C});
     f(p.undrained_modulus, FieldSpec{"undrained_modulus", 1, 0});
     f(p.damage,            FieldSpec{"damage", 1, kState | kGhosted});
     f(p.fracture,          FieldSpec{"fracture", 1, kState});
@@ -204,16 +232,16 @@ struct Points {
     f(p.bond_energy_released, FieldSpec{"bond_energy_released", 1, kState});
     f(p.stress,            FieldSpec{"stress", D * D, kState});
     f(p.couple_stress,     FieldSpec{"couple_stress", R * D, kState});
-    f(p.plastic_strain,    FieldSpec{"plastic_strain", D * D, kState});
-    f(p.plastic_strain_zz, FieldSpec{"plastic_strain_zz", 1, kCheckpoint});
-    f(p.plastic_wryness,   FieldSpec{"plastic_wryness", R * D, kState});
-    f(p.equivalent_plastic_strain, FieldSpec{"equivalent_plastic_strain", 1, kState});
-    f(p.plastic_volumetric_strain, FieldSpec{"plastic_volumetric_strain", 1, kState});
-    f(p.cohesion,          FieldSpec{"cohesion", 1, kState});
-    f(p.stress_zz,         FieldSpec{"stress_zz", 1, kCheckpoint});
-    f(p.plastic_step_start, FieldSpec{"plastic_step_start", 2 * D * D + 2 * R * D + 3, kCheckpoint});
-    f(p.second_order_work, FieldSpec{"second_order_work", 1, kState});
-    f(p.second_order_work_start, FieldSpec{"second_order_work_start", 2 * (D * D + R * D), kCheckpoint});
+    f(p.plastic_strain,    FieldSpec{"plastic_strain", D * D, kState, nullptr, P});
+    f(p.plastic_strain_zz, FieldSpec{"plastic_strain_zz", 1, kCheckpoint, nullptr, P});
+    f(p.plastic_wryness,   FieldSpec{"plastic_wryness", R * D, kState, nullptr, P});
+    f(p.equivalent_plastic_strain, FieldSpec{"equivalent_plastic_strain", 1, kState, nullptr, P});
+    f(p.plastic_volumetric_strain, FieldSpec{"plastic_volumetric_strain", 1, kState, nullptr, P});
+    f(p.cohesion,          FieldSpec{"cohesion", 1, kState, nullptr, P});
+    f(p.stress_zz,         FieldSpec{"stress_zz", 1, kCheckpoint, nullptr, P});
+    f(p.plastic_step_start, FieldSpec{"plastic_step_start", 2 * D * D + 2 * R * D + 3, kCheckpoint, nullptr, P});
+    f(p.second_order_work, FieldSpec{"second_order_work", 1, kState, nullptr, S});
+    f(p.second_order_work_start, FieldSpec{"second_order_work_start", 2 * (D * D + R * D), kCheckpoint, nullptr, S});
     // clang-format on
   }
 };

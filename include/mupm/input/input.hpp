@@ -70,6 +70,7 @@ std::vector<BoundaryCondition> boundary_conditions_from_input(const Teuchos::Par
 struct MemoryNeed {
   double points = 0, bonds_per_point = 0;
   double bytes_per_rank = 0, available_per_rank = 0;
+  double point_field_bytes = 0;  // per point, of the point fields the run allocates
 };
 MemoryNeed memory_need(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& input);
 // Throws InputError (on every rank) when the need exceeds what is available.
@@ -78,6 +79,11 @@ MemoryNeed check_memory(const Teuchos::Comm<int>& comm, const Teuchos::Parameter
 // The files the input names, before any work: Solver->Restart From an HDF5 file, Output->Folder
 // writable (or creatable). Throws InputError on every rank. Collective.
 void check_files(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& input);
+
+// The point-field groups (FieldGroup, include/mupm/data/fields.hpp) a run of this input
+// allocates: those of its modules (a fluid: pore water; Fracture Flow: crack water; Micropolar
+// Drucker-Prager: plastic; a second-order work window) and of every field Output->Fields names.
+unsigned point_field_groups(const Teuchos::ParameterList& input);
 
 // Names of the point fields that can be written (Output->Fields).
 const std::vector<std::string>& output_field_names();

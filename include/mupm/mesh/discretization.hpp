@@ -77,10 +77,12 @@ void exchange_constants(Distribution& dist, Points<Dim>& pts) {
   Kokkos::fence();
 }
 
-// Partitions the lattice, builds maps and the import, generates the owned points, sends the
-// constants to the ghosts and builds the bonds. Collective.
+// Partitions the lattice, builds maps and the import, generates the owned points (the point
+// fields of `field_groups`, include/mupm/data/fields.hpp), sends the constants to the ghosts and
+// builds the bonds. Collective.
 template <int Dim>
-Discretization<Dim> discretize(const Teuchos::RCP<const Comm>& comm, const GridSpec<Dim>& grid) {
+Discretization<Dim> discretize(const Teuchos::RCP<const Comm>& comm, const GridSpec<Dim>& grid,
+                               unsigned field_groups = kAllGroups) {
   ScopedRegion region("mupm::Setup::discretize");
   Discretization<Dim> disc;
   disc.grid = grid;
@@ -88,7 +90,7 @@ Discretization<Dim> discretize(const Teuchos::RCP<const Comm>& comm, const GridS
   const std::vector<GlobalId> owned = box_gids(grid, disc.box);
   const std::vector<GlobalId> ghosts = ghost_gids(grid, disc.box);
   disc.dist = Distribution(comm, owned, ghosts);
-  disc.points.allocate(owned.size(), ghosts.size());
+  disc.points.allocate(owned.size(), ghosts.size(), field_groups);
   fill_owned_from_lattice(grid, owned, disc.points);
   {
     auto gid = Kokkos::create_mirror_view(disc.points.gid);

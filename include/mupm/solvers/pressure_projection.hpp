@@ -47,7 +47,7 @@
 // stabilization below, mirrored pressure layers with stiff or incompressible water were
 // unstable at any step tried (0.1 to 0.5 of it); with it they run (Terzaghi within 1 %), but a
 // Fluid Flux layer (an even image) with incompressible water still diverges, which the input
-// refuses (src/input/input.cpp, check_pressure_integration).
+// refuses (src/input/modules/solver.cpp, check_pressure_integration).
 //
 // What it conserves. Water: each free point's balance holds to the linear solve's tolerance;
 // the bookkeeping (FluidSolver::finish_projection) adds C dp + biot S_r d(tr eps) to the water

@@ -1,0 +1,243 @@
+#include "../input_module.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mupm/input/options.hpp"
+#include "mupm/kernels/j_integral.hpp"
+
+namespace mupm {
+
+using Teuchos::Array;
+using Teuchos::ParameterList;
+using Teuchos::rcp;
+
+namespace {
+
+void declare_fracture(ParameterList& f) {
+  f.set("Bond Breakage", std::string("None"),
+        "None: bonds never break (pre-cracks stay as they are). Energy: a bond breaks once "
+        "its energy W (eq 34, accumulated from the force and moment states over the run) "
+        "reaches W_cr = 4 G_cr/(pi delta^4) in 3D (eq 36), 3 G_cr/(2 h delta^3) in 2D "
+        "(derivation in include/mupm/kernels/fracture.hpp); the energy it holds is booked "
+        "as fracture dissipation. J-Integral (2D, Algorithm 3): the first pre-crack advances "
+        "by J-Integral->Crack Increment along its direction, at most once a step, whenever J/h "
+        "of the first J-Integral contour >= G_cr: the bonds across the increment break.",
+        bond_breaking_options().validator());
+  f.set("Critical Energy Release Rate", 0.0,
+        "G_cr [J/m^2 = N/m] of the Energy and J-Integral criteria (> 0 with them).", at_least(0.0));
+  f.set("Critical Damage", 0.3,
+        "D_cr in (0, 1]: a point with damage D >= D_cr (eq 37) is a fracture point (eq 104; "
+        "the paper gives no value). Points next to a pre-crack are fracture points from the "
+        "start.",
+        rcp(new Teuchos::EnhancedNumberValidator<double>(1e-6, 1.0)));
+  f.set("Bond Energy Force State", std::string("Effective"),
+        "Force state whose work is the bond energy W (eq 34). Effective: the skeleton's, "
+        "sigma-bar K^-1 xi plus stabilization, as the paper's text says (Terzaghi: the "
+        "effective stress breaks the skeleton). Total: with the pore-water part "
+        "-S_r p K^-1 xi, as eq 34 is printed. The same without a fluid.",
+        bond_energy_state_options().validator());
+  f.set("Fracture Flow", false,
+        "true: water in the cracks (Solver->Physics = Hydro-Mechanical). The fracture "
+        "points carry a fracture pressure p_f that flows along the crack by the cubic law "
+        "a^3/(12 mu_w) (mu_w = Fluid->Viscosity), exchanges water with the pores (eq 19) and "
+        "pushes the crack's faces apart; solved implicitly every fluid step (Semi-Implicit: in "
+        "the pore pressure's solve). Conditions: "
+        "Fracture Pressure, Fracture Source. Derivations in "
+        "include/mupm/kernels/fracture_flow.hpp.");
+  f.set("Crack Water Force", std::string("Face Pressure"),
+        "How the crack's water pressure p_f acts on the solid (Fracture Flow). Face "
+        "Pressure: p_f pushes the crack's faces apart (central pair forces on the broken "
+        "bonds, p_f per unit face area), with the undrained p_f* of the opening the solid is "
+        "at (Explicit; Semi-Implicit: the p_f of the joint solve). Eq 17 (Explicit only): as the "
+        "paper prints it, bonds between two fracture points carry -S_rf p_f "
+        "K^-1 xi in place of -S_r p K^-1 xi; those bonds run along the faces, so p_f barely "
+        "acts across the crack (and p_f is that of the last fluid step); its force does work "
+        "the crack water does not supply, and with injection it blows up at any time step "
+        "(inputs/README.md, Example 1). Derivations and why "
+        "in include/mupm/kernels/fracture_flow.hpp.",
+        crack_water_force_options().validator());
+  f.set("Minimum Aperture", 1e-6,
+        "a_min [m]: a film of water in the crack (the paper gives none). The conductance "
+        "takes max(a, a_min); the storage the crack's volume a + a_min, whose opening stores "
+        "water. Explicit: the crack water's stiffness K_w / a_min enters the solid's stable "
+        "step, a small a_min (with a stiff water) means a small step (not Semi-Implicit). With "
+        "Fracture Flow, below Spacing "
+        "(the film fits in a "
+        "crack point's cell).",
+        positive());
+}
+
+// The film of crack water fits a cell; Fracture Flow needs Hydro-Mechanical; breakage a solid
+// and G_cr.
+void check_fracture(ParameterList& input) {
+  const std::string physics = input.sublist("Solver").get<std::string>("Physics");
+  const Physics phys = physics_options()(physics);
+  const ParameterList& fr = input.sublist("Fracture");
+  // a_min is a film of water in a crack point's cell, whose width is Spacing: its porosity
+  // (a + a_min) / (rows dx) reaches 1 at a_min = dx (one row), beyond which the crack would hold
+  // more water than its cell; the film's stiffness K_w / a_min in the stable step then is
+  // meaningless too (1e308 overflowed to a non-finite aperture, 1e50 ran with nothing moving).
+  // Only the crack water uses it.
+  if (fr.get<bool>("Fracture Flow")) {
+    const double amin = fr.get<double>("Minimum Aperture");
+    const double dx = input.sublist("Discretization").get<double>("Spacing");
+    if (!(amin < dx)) {
+      std::ostringstream s;
+      s << "Error, " << path_of(fr, "Minimum Aperture") << " = " << amin
+        << " m is not below the point spacing " << dx
+        << " m (mupm->Discretization->Spacing): the film of water it stands for must fit in a "
+           "crack point's cell (1e-6 m is the default).";
+      throw InputError(s.str());
+    }
+  }
+  if (fr.get<bool>("Fracture Flow") && phys != Physics::HydroMechanical)
+    throw InputError("Error, " + path_of(fr, "Fracture Flow") +
+                     " = true needs Solver->Physics = Hydro-Mechanical (it is " + physics +
+                     "): the crack's water lives between the solid's crack faces.");
+  if (bond_breaking_options()(fr.get<std::string>("Bond Breakage")) != BondBreaking::None) {
+    if (!has_solid(phys))
+      throw InputError("Error, " + path_of(fr, "Bond Breakage") + " = " +
+                       fr.get<std::string>("Bond Breakage") +
+                       " needs Solver->Physics = Micropolar Solid or Hydro-Mechanical (it is " +
+                       physics + "): bonds break by the work of the solid's force states.");
+    if (!(fr.get<double>("Critical Energy Release Rate") > 0))
+      throw InputError("Error, " + path_of(fr, "Critical Energy Release Rate") +
+                       " must be > 0 for " + path_of(fr, "Bond Breakage") + " = " +
+                       fr.get<std::string>("Bond Breakage") + ".");
+  }
+}
+
+unsigned fracture_field_groups(const ParameterList& input) {
+  return input.sublist("Fracture").get<bool>("Fracture Flow") ? unsigned(kGroupCrackWater) : 0u;
+}
+
+void declare_j_integral(ParameterList& j) {
+  j.set("Half Widths", Array<double>(),
+        "Half width along x of each contour (at most 8; empty: no J-integral), in Units. The "
+        "contour's edges are moved to the nearest cell faces.");
+  j.set("Half Heights", Array<double>(),
+        "Half height along y of each contour, in Units (empty: the Half Widths).");
+  j.set("Units", std::string("Spacings"),
+        "Units of Half Widths and Half Heights: Spacings (multiples of "
+        "Discretization->Spacing) or Metres.",
+        contour_units_options().validator());
+  j.set("Crack Increment", 0.0,
+        "Delta a [m] by which the J criterion (Fracture->Bond Breakage = J-Integral) advances "
+        "the crack each time J/h >= Critical Energy Release Rate (0: one Spacing; at most the "
+        "smallest contour half size).",
+        at_least(0.0));
+  j.set("Speed Cap", true,
+        "J criterion: after an advance the next waits Delta a / c_R, c_R = c_s (0.862 + "
+        "1.14 nu)/(1 + nu) the skeleton's Rayleigh wave speed at the initial density (a "
+        "running mode I crack's limit). false: an advance whenever J/h >= G_cr, at most one a "
+        "step (the paper's Algorithm 3), which lets the crack run at Delta a / dt while the "
+        "contours still show the field of before the last increment.");
+}
+
+// J-Integral: 2D, a solid, a pre-crack, matching contour sizes that fit the body at the start.
+void check_j_integral(ParameterList& input, int dim, Physics phys) {
+  ParameterList& j = input.sublist("J-Integral");
+  const ParameterList& fr = input.sublist("Fracture");
+  const bool criterion =
+      bond_breaking_options()(fr.get<std::string>("Bond Breakage")) == BondBreaking::JIntegral;
+  const auto w = j.get<Array<double>>("Half Widths");
+  auto h = j.get<Array<double>>("Half Heights");
+  if (w.empty() && !h.empty())
+    throw InputError("Error, " + path_of(j, "Half Heights") + " is given without " +
+                     path_of(j, "Half Widths") + ".");
+  if (w.empty()) {
+    if (criterion)
+      throw InputError("Error, " + path_of(fr, "Bond Breakage") + " = J-Integral needs " +
+                       path_of(j, "Half Widths") + ": at least one contour around the tip.");
+    return;
+  }
+  const std::string what = path_of(j, "Half Widths");
+  if (dim != 2)
+    throw InputError("Error, " + what + ": the J-integral is 2D (Discretization->Dimension = 2).");
+  if (!has_solid(phys))
+    throw InputError("Error, " + what +
+                     ": the J-integral needs Solver->Physics = Micropolar Solid or "
+                     "Hydro-Mechanical.");
+  const ParameterList& d = input.sublist("Discretization");
+  if (d.sublist("Pre-Cracks").numParams() == 0)
+    throw InputError("Error, " + what +
+                     ": the J-integral's contours surround the tip of the first "
+                     "Discretization->Pre-Cracks entry; there is none.");
+  if (w.size() > kMaxContours)
+    throw InputError("Error, " + what + " lists " + std::to_string(w.size()) +
+                     " contours; at most " + std::to_string(kMaxContours) + " are supported.");
+  if (!h.empty() && h.size() != w.size())
+    throw InputError("Error, " + path_of(j, "Half Heights") + " has " + std::to_string(h.size()) +
+                     " values and " + what + " " + std::to_string(w.size()) +
+                     ": give one per contour, or none.");
+  if (h.empty())
+    h = w;
+  const double dx = d.get<double>("Spacing");
+  const double unit =
+      contour_units_options()(j.get<std::string>("Units")) == ContourUnits::Metres ? 1.0 : dx;
+  for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
+    for (double v : {w[k], h[k]})
+      if (!(v * unit >= dx))
+        throw InputError("Error, " + what + " / Half Heights: contour " + std::to_string(k + 1) +
+                         " has a half size of " + std::to_string(v * unit) +
+                         " m, below one Spacing (" + std::to_string(dx) +
+                         " m): a contour must hold the tip and the points around it.");
+  // The contours at the start, centred on the first pre-crack's End, inside the real body (their
+  // edges go to the nearest cell faces, at most dx/2 away): a contour beyond it runs through no
+  // material, and J came out 0.012 for 0.93 with a half width past the body's faces.
+  const ParameterList& cracks = d.sublist("Pre-Cracks");
+  const auto tip = cracks.sublist(cracks.name(cracks.begin())).get<Array<double>>("End");
+  const auto counts = d.get<Array<int>>("Counts");
+  const auto ext = d.get<Array<double>>("Extents");
+  const auto origin = d.get<Array<double>>("Origin");
+  for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
+    for (int a = 0; a < 2; ++a) {
+      const double o = origin.empty() ? 0.0 : origin[a];
+      const double n = counts.empty() ? std::round(ext[a] / dx) : double(counts[a]);
+      const double half = (a == 0 ? w[k] : h[k]) * unit;
+      if (tip[a] - half < o - 0.5 * dx || tip[a] + half > o + n * dx + 0.5 * dx) {
+        std::ostringstream m;
+        m << "Error, " << (a == 0 ? what : path_of(j, "Half Heights")) << ": contour " << k + 1
+          << " spans " << (a == 0 ? 'x' : 'y') << " = " << tip[a] - half << " to " << tip[a] + half
+          << " m around the first pre-crack's End, beyond the body (" << o << " to " << o + n * dx
+          << " m): the contour must run through the material. Give a smaller half size.";
+        throw InputError(m.str());
+      }
+    }
+  const double inc = j.get<double>("Crack Increment");
+  for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
+    if (criterion && std::min(w[k], h[k]) * unit < inc)
+      throw InputError("Error, " + path_of(j, "Crack Increment") + " = " + std::to_string(inc) +
+                       " m exceeds the half size of contour " + std::to_string(k + 1) + " (" +
+                       std::to_string(std::min(w[k], h[k]) * unit) +
+                       " m): an increment must stay inside the contours (it is in metres).");
+}
+
+void check_j(ParameterList& input) {
+  check_j_integral(input, input.sublist("Discretization").get<int>("Dimension"),
+                   physics_options()(input.sublist("Solver").get<std::string>("Physics")));
+}
+
+}  // namespace
+
+InputModule fracture_input() {
+  return {"Fracture",
+          "Bond breakage (Solver->Physics = Micropolar Solid or Hydro-Mechanical), damage and "
+          "fracture points.",
+          declare_fracture, check_fracture, fracture_field_groups};
+}
+
+InputModule j_integral_input() {
+  return {"J-Integral",
+          "The micropolar J-integral (eqs 30, 125-126) around the tip of the first pre-crack, "
+          "on rectangular contours centred on the tip (2D). Time-series columns j_integral, "
+          "j_translational, j_rotational (first contour) and j_integral_<k> (contour k >= 2), "
+          "per unit thickness [J/m^2 = Pa m]. The tip: with Fracture->Bond Breakage = "
+          "J-Integral the pre-crack's End advanced by the crack's increments, otherwise the "
+          "tracked tip (crack_tip_x/y). Derivation and discretization in "
+          "include/mupm/kernels/j_integral.hpp.",
+          declare_j_integral, check_j, nullptr};
+}
+
+}  // namespace mupm
