@@ -17,10 +17,10 @@ std::string path_of(const Teuchos::ParameterList& list, const std::string& name)
   return list.name() + "->" + name;
 }
 
-std::string joined(const std::vector<std::string>& v) {
+std::string joined(const std::vector<std::string>& v, const char* last) {
   std::string out;
   for (std::size_t k = 0; k < v.size(); ++k)
-    out += (k == 0 ? "" : k + 1 == v.size() ? " or " : ", ") + v[k];
+    out += (k == 0 ? "" : k + 1 == v.size() ? last : ", ") + v[k];
   return out;
 }
 

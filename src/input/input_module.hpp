@@ -48,7 +48,8 @@ InputModule diagnostics_input();          // modules/output.cpp
 // Helpers of the declarations and checks (input_module.cpp).
 inline const std::vector<std::string> kFaces = {"-x", "+x", "-y", "+y", "-z", "+z"};
 std::string path_of(const Teuchos::ParameterList& list, const std::string& name);
-std::string joined(const std::vector<std::string>& v);
+// "a, b or c" (`last` between the last two).
+std::string joined(const std::vector<std::string>& v, const char* last = " or ");
 template <class T>
 Teuchos::RCP<Teuchos::EnhancedNumberValidator<T>> at_least(T lo) {
   return Teuchos::rcp(new Teuchos::EnhancedNumberValidator<T>(lo, std::numeric_limits<T>::max()));

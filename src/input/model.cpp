@@ -119,21 +119,6 @@ const Options<BondEnergyState>& bond_energy_state_options() {
       {{"Effective", BondEnergyState::Effective}, {"Total", BondEnergyState::Total}});
   return o;
 }
-const Options<BoundaryCondition::Kind>& boundary_condition_options() {
-  static const Options<BoundaryCondition::Kind> o(
-      "Type", {{"Displacement", BoundaryCondition::Displacement},
-               {"Velocity", BoundaryCondition::Velocity},
-               {"Micro-Rotation", BoundaryCondition::MicroRotation},
-               {"Traction", BoundaryCondition::Traction},
-               {"Body Force", BoundaryCondition::BodyForce},
-               {"Body Couple", BoundaryCondition::BodyCouple},
-               {"Pore Pressure", BoundaryCondition::PorePressure},
-               {"Fluid Source", BoundaryCondition::FluidSource},
-               {"Fluid Flux", BoundaryCondition::FluidFlux},
-               {"Fracture Pressure", BoundaryCondition::FracturePressure},
-               {"Fracture Source", BoundaryCondition::FractureSource}});
-  return o;
-}
 const Options<TimeFunction::Kind>& time_function_options() {
   static const Options<TimeFunction::Kind> o("Time Function", {{"Constant", TimeFunction::Constant},
                                                                {"Ramp", TimeFunction::Ramp},

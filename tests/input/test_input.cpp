@@ -236,6 +236,21 @@ TEST(Input, MirroredKinematicConditions) {
   // Layers as thick as the default (more than 2 rows) on a body 2 rows high.
   refused(input(clamp, "{10, 2}"),
           {"mupm->Boundary Conditions->bx->Region", "rows thick, but the body is 2 rows along y"});
+  // What each kind takes (the kinds' table, src/input/modules/conditions.cpp): only the
+  // mirrorable kinds mirror, a rotation axis is z in 2D, a force is along x or y.
+  refused(input(cond("push", "Layer -y", "Body Force", "y")),
+          {"mupm->Boundary Conditions->push->Boundary Layer Values = Mirrored",
+           "only Pore Pressure, Fracture Pressure, Displacement, Velocity and Micro-Rotation "
+           "conditions mirror",
+           "Body Force conditions hold the prescribed value"});
+  std::string couple = cond("turn", "Layer -y", "Body Couple", "x");
+  couple.replace(couple.find("Mirrored"), 8, "Default");
+  refused(input(couple), {"mupm->Boundary Conditions->turn->Component = x",
+                          "in 2D the micro-rotation is about z"});
+  std::string force = cond("pull", "Layer -y", "Body Force", "z");
+  force.replace(force.find("Mirrored"), 8, "Default");
+  refused(input(force),
+          {"mupm->Boundary Conditions->pull->Component = z", "a 2D body has components x and y"});
 }
 
 TEST(Input, SolidAndBoundaryConditions) {

@@ -11,6 +11,74 @@ using Teuchos::rcp;
 
 namespace {
 
+// The kinds of Boundary Conditions->NAME->Type. Each declares its name, its part of Type's doc
+// string and what it takes: a rotation axis as Component, a Traction Distribution, which
+// Boundary Layer Values. The Type validator (boundary_condition_options), its doc and the checks
+// below follow; what a kind needs of the physics is BoundaryCondition::fluid() and
+// fracture_fluid() (include/mupm/kernels/boundary_conditions.hpp), where the kind acts. A new
+// kind: its enum value and kernel there, its entry here, where it acts in the solvers.
+enum class LayerValues {
+  Held,        // its layer points hold the prescribed value (Default or Constant)
+  Mirrorable,  // Boundary Layer Values = Mirrored accepted
+  FromFlux,    // its layer points take the flux's continuation of the body's pressure (Default)
+};
+struct ConditionKind {
+  const char* name;
+  BoundaryCondition::Kind kind;
+  const char* doc;
+  bool rotation = false;     // Component is a rotation axis (z in 2D)
+  bool distributed = false;  // Traction Distribution = Consistent accepted
+  LayerValues layer = LayerValues::Held;
+};
+
+const std::vector<ConditionKind>& condition_kinds() {
+  using B = BoundaryCondition;
+  constexpr LayerValues M = LayerValues::Mirrorable;
+  static const std::vector<ConditionKind> k = {
+      {"Displacement", B::Displacement,
+       "[m] prescribed on the region's points (the boundary-layer method: use a boundary layer "
+       "region)",
+       false, false, M},
+      {"Velocity", B::Velocity, "[m/s] prescribed on the region's points", false, false, M},
+      {"Micro-Rotation", B::MicroRotation,
+       "[rad] prescribed on the region's points (Component: the rotation axis)", true, false, M},
+      {"Traction", B::Traction,
+       "[Pa] applied as a body force traction/dx on the region's points (make it the outermost "
+       "real row of the face), or as Traction Distribution says",
+       false, true},
+      {"Body Force", B::BodyForce, "[N/m^3]"},
+      {"Body Couple", B::BodyCouple, "[N m/m^3] (Component: the rotation axis)", true},
+      {"Pore Pressure", B::PorePressure,
+       "[Pa] prescribed on the region's points (a drained boundary; boundaries without one are "
+       "impervious; Solver->Physics = Pore Fluid or Hydro-Mechanical, as for every fluid "
+       "condition)",
+       false, false, M},
+      {"Fluid Source", B::FluidSource,
+       "[m^3/s; in 2D m^3/s per metre of thickness]: water injected at Value spread over the "
+       "region's points by volume (a point source: a region holding one point; a line: a "
+       "one-row region; negative: extraction)"},
+      {"Fluid Flux", B::FluidFlux,
+       "[m/s]: water flowing into the body through a face at Value (negative: out), on a "
+       "boundary layer region (e.g. 'Layer -y'): its points outside one face take the pressure "
+       "that continues the body's with the gradient of that flux (README, 'Boundary layers')",
+       false, false, LayerValues::FromFlux},
+      {"Fracture Pressure", B::FracturePressure,
+       "[Pa] prescribed on the region's fracture points (Fracture->Fracture Flow = true, as for "
+       "Fracture Source)",
+       false, false, M},
+      {"Fracture Source", B::FractureSource,
+       "[m^3/s; in 2D per metre of thickness]: water injected into the region's fracture points "
+       "at Value (e.g. at a crack's mouth; an error if the region has no fracture point)"}};
+  return k;
+}
+
+const ConditionKind& condition_kind(const std::string& name) {
+  for (const ConditionKind& k : condition_kinds())
+    if (name == k.name)
+      return k;
+  throw std::logic_error("unknown boundary-condition kind " + name);  // validated before
+}
+
 const char* const kHydrostatic = kHydrostaticPorePressure;
 std::vector<std::string> ic_fields() {
   std::vector<std::string> out;
@@ -49,25 +117,11 @@ void ic_template(ParameterList& c) {
 }
 
 void bc_template(ParameterList& c) {
-  c.set("Type", std::string("Displacement"),
-        "Displacement [m], Velocity [m/s] or Micro-Rotation [rad] prescribed on the region's "
-        "points (the boundary-layer method: use a boundary layer region), or Traction [Pa] "
-        "applied as a body force traction/dx on the region's points (make it the outermost real "
-        "row of the face), or Body Force [N/m^3], or Body Couple [N m/m^3] (Component: the "
-        "rotation axis). Fluid (Solver->Physics = Pore Fluid or Hydro-Mechanical): Pore "
-        "Pressure [Pa] prescribed on the region's points (a drained boundary; boundaries "
-        "without one are impervious), or Fluid Source: water injected at Value [m^3/s; in 2D "
-        "m^3/s per metre of thickness] spread over the region's points by volume (a point "
-        "source: a region holding one point; a line: a one-row region; negative: extraction), "
-        "or Fluid Flux: water flowing into the body through a face at Value [m/s] (negative: "
-        "out), on a boundary layer region (e.g. 'Layer -y'): its points outside one face take "
-        "the pressure that continues the body's with the gradient of that flux (README, "
-        "'Boundary layers'). "
-        "Fracture (Fracture->Fracture Flow = true): Fracture Pressure [Pa] prescribed on the "
-        "region's fracture points, or Fracture Source: water injected into the region's "
-        "fracture points at Value [m^3/s; in 2D per metre of thickness] (e.g. at a crack's "
-        "mouth; an error if the region has no fracture point). "
-        "Component is ignored by the fluid conditions.",
+  std::string doc = "The condition's kind, one of: ";
+  for (const ConditionKind& k : condition_kinds())
+    doc += std::string(&k == &condition_kinds().front() ? "" : "; ") + k.name + " " + k.doc;
+  c.set("Type", std::string(condition_kinds().front().name),
+        doc + ". Component is ignored by the fluid conditions.",
         boundary_condition_options().validator());
   c.set("Region", std::string("All"), "Region name (Discretization->Regions, 'Layer -y', All).");
   c.set("Component", std::string("x"),
@@ -145,11 +199,10 @@ void check_boundary_conditions(ParameterList& input) {
   for (auto it = bcs.begin(); it != bcs.end(); ++it) {
     ParameterList& c = bcs.sublist(bcs.name(it));
     check_region(c, regions, faces);
-    const auto type = boundary_condition_options()(c.get<std::string>("Type"));
+    const ConditionKind& kind = condition_kind(c.get<std::string>("Type"));
     const std::string comp = c.get<std::string>("Component");
     const int axis = component_options()(comp);
-    const bool rotation =
-        type == BoundaryCondition::MicroRotation || type == BoundaryCondition::BodyCouple;
+    const bool rotation = kind.rotation;
     if (rotation && dim == 2 && axis != 2)
       throw InputError("Error, " + path_of(c, "Component") + " = " + comp +
                        ": in 2D the micro-rotation is about z; write z.");
@@ -157,14 +210,13 @@ void check_boundary_conditions(ParameterList& input) {
       throw InputError("Error, " + path_of(c, "Component") + " = " + comp + ": a " +
                        std::to_string(dim) + "D body has components x" +
                        (dim == 3 ? ", y and z." : " and y."));
-    if (type != BoundaryCondition::Traction &&
-        c.get<std::string>("Traction Distribution") != "Outer Row")
+    if (!kind.distributed && c.get<std::string>("Traction Distribution") != "Outer Row")
       throw InputError("Error, " + path_of(c, "Traction Distribution") + " = " +
                        c.get<std::string>("Traction Distribution") +
                        ": only a Traction is distributed; a " + c.get<std::string>("Type") +
                        " condition takes Outer Row (the default).");
     // Fluid Flux sets its layer one way only (the flux's continuation of the body's pressure).
-    if (type == BoundaryCondition::FluidFlux &&
+    if (kind.layer == LayerValues::FromFlux &&
         c.get<std::string>("Boundary Layer Values") != "Default")
       throw InputError("Error, " + path_of(c, "Boundary Layer Values") + " = " +
                        c.get<std::string>("Boundary Layer Values") +
@@ -175,14 +227,21 @@ void check_boundary_conditions(ParameterList& input) {
     // without bound at H = 40 dx). Kinematic conditions mirror by the reflection R (a symmetry
     // plane) or by slaving energy-free layers (input/model.cpp, kernels/boundary_conditions.hpp).
     if (c.get<std::string>("Boundary Layer Values") == "Mirrored" &&
-        type != BoundaryCondition::PorePressure && type != BoundaryCondition::FracturePressure &&
-        type != BoundaryCondition::Displacement && type != BoundaryCondition::Velocity &&
-        type != BoundaryCondition::MicroRotation)
-      throw InputError("Error, " + path_of(c, "Boundary Layer Values") +
-                       " = Mirrored: only Pore Pressure, Fracture Pressure, Displacement, Velocity "
-                       "and Micro-Rotation conditions mirror their boundary-layer values; " +
+        kind.layer != LayerValues::Mirrorable) {
+      std::vector<std::string> mirrorable;
+      for (const bool pressure : {true, false})  // the pressures, then the kinematic kinds
+        for (const ConditionKind& k : condition_kinds()) {
+          BoundaryCondition b;
+          b.kind = k.kind;
+          if (k.layer == LayerValues::Mirrorable && b.fluid() == pressure)
+            mirrorable.push_back(k.name);
+        }
+      throw InputError("Error, " + path_of(c, "Boundary Layer Values") + " = Mirrored: only " +
+                       joined(mirrorable, " and ") +
+                       " conditions mirror their boundary-layer values; " +
                        c.get<std::string>("Type") +
                        " conditions hold the prescribed value (write Constant or Default).");
+    }
     const auto tf = time_function_options()(c.get<std::string>("Time Function"));
     if (tf == TimeFunction::Ramp && !(c.get<double>("Ramp Time") > 0))
       throw InputError("Error, " + path_of(c, "Ramp Time") + " must be > 0 for a Ramp.");
@@ -229,6 +288,16 @@ void check_initial_conditions(ParameterList& input) {
 }
 
 }  // namespace
+
+const Options<BoundaryCondition::Kind>& boundary_condition_options() {
+  static const Options<BoundaryCondition::Kind> o("Type", [] {
+    std::vector<std::pair<std::string, BoundaryCondition::Kind>> table;
+    for (const ConditionKind& k : condition_kinds())
+      table.emplace_back(k.name, k.kind);
+    return table;
+  }());
+  return o;
+}
 
 InputModule boundary_conditions_input() {
   return {"Boundary Conditions", "One sublist per condition, named as you like.",
