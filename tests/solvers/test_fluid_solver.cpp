@@ -103,8 +103,8 @@ TEST(FluidSolver, MassConservation) {
 // explicit scheme's energy identity: round-off on a stable step (0.5 x the estimate here), with
 // a positive dissipation. On an unstable one (1.1 x) the dissipation turns negative and the
 // stored energy outgrows everything supplied: the driver's divergence check
-// (src/solvers/simulation.cpp) stops the run while the state is still finite (at step 28 here,
-// where the unstable mode's points wet to saturation and their storage falls 1e4-fold).
+// (src/solvers/driver/step_checks.hpp) stops the run while the state is still finite (at step 28
+// here, where the unstable mode's points wet to saturation and their storage falls 1e4-fold).
 TEST(FluidSolver, EnergyBalanceFlagsInstability) {
   const double dx = 0.01;
   auto g = test::box<2>({16, 12}, 3.015, dx);

@@ -40,7 +40,7 @@
 // step: 1.3 % of the largest term at steps 21-29, and 2.3 % at every step with only the flow's
 // own part left; Example 3's fast van Genuchten storage changes up to 4.8 %). An unstable step
 // makes D negative in its growing modes and the stored energy grow beyond all supply: the
-// driver's divergence check stops it (src/solvers/simulation.cpp, StepChecks). The driver
+// driver's divergence check stops it (src/solvers/driver/step_checks.hpp, StepChecks). The driver
 // checks the balance against Solver->Energy Tolerance like the solid's (eq 149).
 #ifndef MUPM_FLUID_SOLVER_HPP
 #define MUPM_FLUID_SOLVER_HPP

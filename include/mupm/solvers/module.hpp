@@ -61,7 +61,7 @@ struct EnergyBalance {
   // pressure, by the crack at its own), signed; `gross` sums the same terms' magnitudes. The
   // work exchanged between the solid and the waters (W_pore, W_c, W_sk) is not in them: it
   // grows with a blow-up of the coupling itself (StepChecks::coupled in
-  // src/solvers/simulation.cpp).
+  // src/solvers/driver/step_checks.hpp).
   std::string external_expression;
   double external = 0, gross = 0;
   const char* field = "displacement";  // registry field whose largest value locates a blow-up

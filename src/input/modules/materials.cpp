@@ -14,7 +14,7 @@ namespace {
 // string, the parameters it adds to Materials, its checks (with a solid) and the point-field
 // groups it needs; the elastic law's constants below (Bulk Modulus to Length Scale) are every
 // law's. A new law adds its entry here; its solver is instantiated from
-// include/mupm/laws/laws.hpp, built by the driver (src/solvers/simulation.cpp, assemble) and
+// include/mupm/laws/laws.hpp, built by the driver (src/solvers/driver/assembly.hpp, assemble) and
 // given its constants by model_from_input (src/input/model.cpp).
 struct LawInput {
   const char* name;
