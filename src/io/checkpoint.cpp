@@ -253,9 +253,7 @@ void read_checkpoint(const std::string& path, Discretization<Dim>& disc, long lo
   }
   // A field group the writing run did not allocate (one that only this run's Output->Fields
   // asks for) has no datasets: its fields stay zero, as the writer's were.
-  const unsigned written = file.has_attribute("point_field_groups")
-                               ? unsigned(file.read_attribute_int("point_field_groups"))
-                               : kAllGroups;
+  const unsigned written = unsigned(file.read_attribute_int("point_field_groups"));
   for_each_checkpointed(disc.points, [&](const auto& view, const FieldSpec& s) {
     if (!(s.group & written))
       return;

@@ -91,8 +91,8 @@ struct Points {
   Scalars bond_energy_released;  // energy released by the point's broken bonds [J], half of
                                  // W V_i V_j per bond (the other half is at the other end)
   // Constitutive state: effective stress, couple stress, and the plastic state of Materials->
-  // Model = Micropolar Drucker-Prager (include/mupm/laws/micropolar_drucker_prager.hpp; zero
-  // with the elastic law).
+  // Model = Micropolar Drucker-Prager (include/mupm/laws/micropolar_drucker_prager.hpp; not
+  // allocated with the elastic law unless Output->Fields names one of its fields, then zero).
   Vectors stress;                     // sigma-bar [n][Dim*Dim], row-major, non-symmetric
   Vectors couple_stress;              // m [n][RotDim*Dim]
   Vectors plastic_strain;             // eps^p [n][Dim*Dim], row-major (the additive split, eq 82)
@@ -207,7 +207,8 @@ struct Points {
     f(p.alpha,             FieldSpec{"micro_rotation_acceleration", R, kCheckpoint | kFinite});
     f(p.p,                 FieldSpec{"pore_pressure", 1, kState | kGhosted | kFinite, "Pore Pressure"});
     f(p.p_rate,            FieldSpec{"pore_pressure_rate", 1, kCheckpoint, nullptr, W});
-    f(p.pf,                FieldSpec{"fracture_pressure", 1, kState | kGhosted | kFinite, nullptr, C});
+    f(p.pf,                FieldSpec{"fracture_pressure", 1, kState | kGhosted | kFinite,
+                                     nullptr, C});
     f(p.pf_rate,           FieldSpec{"fracture_pressure_rate", 1, kCheckpoint, nullptr, C});
     f(p.pf_saturation,     FieldSpec{"fracture_saturation", 1, kState | kGhosted, nullptr, C});
     f(p.pf_content,        FieldSpec{"fracture_fluid_content", 1, kState, nullptr, C});
@@ -239,9 +240,11 @@ struct Points {
     f(p.plastic_volumetric_strain, FieldSpec{"plastic_volumetric_strain", 1, kState, nullptr, P});
     f(p.cohesion,          FieldSpec{"cohesion", 1, kState, nullptr, P});
     f(p.stress_zz,         FieldSpec{"stress_zz", 1, kCheckpoint, nullptr, P});
-    f(p.plastic_step_start, FieldSpec{"plastic_step_start", 2 * D * D + 2 * R * D + 3, kCheckpoint, nullptr, P});
+    f(p.plastic_step_start, FieldSpec{"plastic_step_start", 2 * D * D + 2 * R * D + 3,
+                                      kCheckpoint, nullptr, P});
     f(p.second_order_work, FieldSpec{"second_order_work", 1, kState, nullptr, S});
-    f(p.second_order_work_start, FieldSpec{"second_order_work_start", 2 * (D * D + R * D), kCheckpoint, nullptr, S});
+    f(p.second_order_work_start, FieldSpec{"second_order_work_start", 2 * (D * D + R * D),
+                                           kCheckpoint, nullptr, S});
     // clang-format on
   }
 };

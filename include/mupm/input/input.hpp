@@ -82,7 +82,8 @@ void check_files(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& i
 
 // The point-field groups (FieldGroup, include/mupm/data/fields.hpp) a run of this input
 // allocates: those of its modules (a fluid: pore water; Fracture Flow: crack water; Micropolar
-// Drucker-Prager: plastic; a second-order work window) and of every field Output->Fields names.
+// Drucker-Prager: plastic and second-order work) and of every field Output->Fields names
+// (second_order_work there also turns the second-order work on).
 unsigned point_field_groups(const Teuchos::ParameterList& input);
 
 // Names of the point fields that can be written (Output->Fields).

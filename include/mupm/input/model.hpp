@@ -68,8 +68,10 @@ struct RunSettings {
   std::string folder = "output";
   std::vector<std::string> fields;
   int field_interval = 10, series_interval = 1, checkpoint_interval = 0;
-  int second_order_window = 0;         // 0: field_interval
-  unsigned field_groups = kAllGroups;  // the point fields allocated (point_field_groups)
+  int second_order_window = 0;  // 0: field_interval
+  // The point fields allocated (point_field_groups; model_from_input sets it). The second-order
+  // work is computed where its group is.
+  unsigned field_groups = kAllGroups;
   bool checkpoint_at_end = true;
   double progress_interval = 5;
   // Diagnostics.

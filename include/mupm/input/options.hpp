@@ -1,7 +1,9 @@
 // Enumerated input options, typed once: each option's strings and enum values are one table,
 // from which the input's validator (Teuchos StringToIntegralParameterEntryValidator, so
-// --print-defaults lists the choices) and the conversion to the enum both follow. Below the input
-// layer nobody compares option strings.
+// --print-defaults lists the choices) and the conversion to the enum both follow. The tables are
+// in src/input/model.cpp, but for Materials->Model (the laws' entries, src/input/modules/
+// materials.cpp) and Boundary Conditions->NAME->Type (the kinds' entries, modules/conditions.cpp).
+// Below the input layer nobody compares option strings.
 #ifndef MUPM_OPTIONS_HPP
 #define MUPM_OPTIONS_HPP
 

@@ -19,8 +19,10 @@ namespace mupm {
 // The layout this mupm writes and reads (attribute mupm_checkpoint_version). 2: restart globals
 // by name. 3: the crack water's face-area share (fracture_face_area), the run's time step
 // (stable_steps/time_step) and the crack water's energy globals: a version-2 checkpoint lacks
-// them, and is refused by its version rather than by a missing field.
-inline constexpr long long kCheckpointVersion = 3;
+// them, and is refused by its version rather than by a missing field. 4: only the point fields
+// the run allocated (include/mupm/data/fields.hpp), their groups in the attribute
+// point_field_groups.
+inline constexpr long long kCheckpointVersion = 4;
 
 // Named scalars, each pointing at its owner's value (written from it, read into it).
 using NamedGlobals = std::vector<GlobalRef>;

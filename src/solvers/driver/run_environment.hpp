@@ -12,6 +12,7 @@
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -20,6 +21,7 @@
 #include <ostream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "mupm/core/error.hpp"
 #include "mupm/core/types.hpp"

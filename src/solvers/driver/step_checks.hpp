@@ -6,8 +6,10 @@
 #include <mpi.h>
 
 #include <cmath>
+#include <map>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -187,14 +189,18 @@ class StepChecks {
     const auto& pts = disc_.points;
     std::vector<double> rows;
     int nc = 1;
+    bool found = false;
     pts.for_each_field([&](const auto& view, const FieldSpec& s) {
       using V = std::decay_t<decltype(view)>;
       if constexpr (std::is_same_v<typename V::value_type, double>)
         if (name == s.name) {
           rows = io::owned_rows(view, pts.n_owned);
           nc = s.ncomp;
+          found = true;
         }
     });
+    if (!found)  // not a double field, or its group not allocated
+      throw std::logic_error("StepChecks: no allocated point field " + name);
     struct {
       double v;
       int rank;

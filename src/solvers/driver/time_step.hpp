@@ -6,6 +6,7 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <ostream>
 #include <sstream>
