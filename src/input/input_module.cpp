@@ -1,6 +1,8 @@
 #include "input_module.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace mupm {
 
@@ -22,6 +24,16 @@ std::string joined(const std::vector<std::string>& v, const char* last) {
   for (std::size_t k = 0; k < v.size(); ++k)
     out += (k == 0 ? "" : k + 1 == v.size() ? last : ", ") + v[k];
   return out;
+}
+
+std::string exact(double x) {
+  char buf[32];
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    if (std::strtod(buf, nullptr) == x)
+      break;
+  }
+  return buf;
 }
 
 Teuchos::RCP<Teuchos::EnhancedNumberValidator<double>> positive() {

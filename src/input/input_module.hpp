@@ -3,7 +3,8 @@
 // validators; the checks Teuchos' validators cannot make (across parameters and sublists); and
 // the point-field groups (include/mupm/data/fields.hpp) it makes a run allocate.
 // valid_parameters, validate_input and point_field_groups (src/input/input.cpp) follow from the
-// list of modules, input_modules(). Private to the input layer.
+// list of modules, input_modules(). Private to the input layer and the constitutive laws'
+// registrations (src/solvers/laws/), which declare their parameters with its helpers.
 #ifndef MUPM_SRC_INPUT_MODULE_HPP
 #define MUPM_SRC_INPUT_MODULE_HPP
 
@@ -48,6 +49,8 @@ InputModule diagnostics_input();          // modules/output.cpp
 // Helpers of the declarations and checks (input_module.cpp).
 inline const std::vector<std::string> kFaces = {"-x", "+x", "-y", "+y", "-z", "+z"};
 std::string path_of(const Teuchos::ParameterList& list, const std::string& name);
+// The shortest text of x that reads back as x exactly (a change in the last bit is a change).
+std::string exact(double x);
 // "a, b or c" (`last` between the last two).
 std::string joined(const std::vector<std::string>& v, const char* last = " or ");
 template <class T>

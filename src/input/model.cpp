@@ -1,5 +1,7 @@
 #include "mupm/input/model.hpp"
 
+#include "input_module.hpp"
+
 #include "mupm/kernels/fracture_flow.hpp"
 
 #include <Teuchos_Array.hpp>
@@ -15,17 +17,6 @@ using Teuchos::Array;
 using Teuchos::ParameterList;
 
 namespace {
-
-// The shortest text of x that reads back as x exactly (a change in the last bit is a change).
-std::string exact(double x) {
-  char buf[32];
-  for (int digits = 15; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-    if (std::strtod(buf, nullptr) == x)
-      break;
-  }
-  return buf;
-}
 
 // A value as text that tells any two values apart.
 std::string exact_text(const Teuchos::ParameterEntry& e) {
@@ -145,7 +136,7 @@ inline std::string kind_name(const BoundaryCondition& bc) {
 }
 template <int Dim>
 void check_mirrored_kinematic(const GridSpec<Dim>& g, std::vector<BoundaryCondition>& bcs,
-                              const std::string& root, Physics physics, ConstitutiveModel model,
+                              const std::string& root, Physics physics, const LawRegistration& law,
                               BondBreaking breaking, bool j_contours) {
   const char* axes = "xyz";
   // Whether region mask b reaches the points of region mask a (outside face `axis`) that lie
@@ -207,9 +198,13 @@ void check_mirrored_kinematic(const GridSpec<Dim>& g, std::vector<BoundaryCondit
                                   ? std::string()
                                   : std::string(" of component ") + axes[bc.component]) +
                              " slaves its layer (energy-free points)";
-    if (model != ConstitutiveModel::MicropolarElastic || breaking != BondBreaking::None)
+    std::vector<std::string> laws;
+    for (const LawRegistration* l : law_registry())
+      if (l->energy_free_points)
+        laws.push_back(l->name);
+    if (!law.energy_free_points || breaking != BondBreaking::None)
       throw InputError("Error, " + path + what + ", which is implemented for " + root +
-                       "->Materials->Model = Micropolar Elastic with " + root +
+                       "->Materials->Model = " + joined(laws) + " with " + root +
                        "->Fracture->Bond Breakage = None only; write Constant, or mirror the "
                        "normal Displacement alone (a symmetry plane).");
     if (j_contours)
@@ -369,7 +364,10 @@ Model<Dim> model_from_input(const ParameterList& input) {
     m.gravity[k] = g[k];
   m.damping = solver.get<double>("Damping");
 
-  m.constitutive_model = constitutive_model_options()(materials.get<std::string>("Model"));
+  m.law = &law_named(materials.get<std::string>("Model"));
+  m.materials = materials;
+  if (m.law->warn)
+    m.law->warn(materials, m.warnings);
   auto law = MicropolarElastic::from_bulk_shear(
       materials.get<double>("Bulk Modulus"), materials.get<double>("Shear Modulus"),
       materials.get<double>("Micropolar Shear Modulus"), materials.get<double>("Length Scale"));
@@ -385,23 +383,6 @@ Model<Dim> model_from_input(const ParameterList& input) {
       stabilization_modulus_options()(materials.get<std::string>("Stabilization Modulus")));
   if (plane_stress)
     m.solid.pore = m.material.plane_stress_coupling();
-  const double deg = kPi / 180;
-  m.plasticity.friction = materials.get<double>("Friction Angle") * deg;
-  m.plasticity.dilation = materials.get<double>("Dilation Angle") * deg;
-  m.plasticity.cohesion = materials.get<double>("Cohesion");
-  m.plasticity.residual = materials.get<double>("Residual Cohesion");
-  m.plasticity.softening = materials.get<double>("Softening Modulus");
-  // psi > phi: the plastic dissipation per d lambda, q + sqrt3 a3 p-bar = k c + sqrt3 (a3 - a1)
-  // p-bar on the yield surface (include/mupm/laws/micropolar_drucker_prager.hpp), turns negative
-  // under a mean compression -p-bar beyond k c / (sqrt3 (a3 - a1)).
-  if (m.constitutive_model == ConstitutiveModel::MicropolarDruckerPrager &&
-      m.plasticity.dilation > m.plasticity.friction)
-    m.warnings.push_back(
-        "mupm->Materials->Dilation Angle = " + exact(materials.get<double>("Dilation Angle")) +
-        " exceeds Friction Angle = " + exact(materials.get<double>("Friction Angle")) +
-        " degrees: the plastic dissipation turns negative (energy made by plastic flow) under "
-        "a mean compressive stress beyond k c / (sqrt3 (a3 - a1)) (eqs 87-91); soils have psi "
-        "<= phi");
   m.solid_density = materials.get<double>("Solid Density");
   m.porosity = materials.get<double>("Porosity");
 
@@ -471,8 +452,8 @@ Model<Dim> model_from_input(const ParameterList& input) {
   m.boundary_conditions = boundary_conditions_from_input(input);
   for (const auto& bc : m.boundary_conditions)
     m.grid.mirrored_layers = m.grid.mirrored_layers || bc.mirrored;
-  check_mirrored_kinematic(m.grid, m.boundary_conditions, input.name(), r.physics,
-                           m.constitutive_model, m.fracture.criterion, !m.j_integral.half.empty());
+  check_mirrored_kinematic(m.grid, m.boundary_conditions, input.name(), r.physics, *m.law,
+                           m.fracture.criterion, !m.j_integral.half.empty());
   check_fluid_flux(m.grid, m.boundary_conditions, input.name());
   check_consistent_traction(m.grid, m.boundary_conditions, input.name());
   m.initial_conditions = initial_conditions_from_input(input);

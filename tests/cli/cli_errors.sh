@@ -139,6 +139,12 @@ sed -e 's|<ParameterList name="hold2">.*</ParameterList></ParameterList>|</Param
   -e 's|<ParameterList name="Materials">|<ParameterList name="Fracture"><Parameter name="Bond Breakage" type="string" value="Energy"/><Parameter name="Critical Energy Release Rate" type="double" value="100"/></ParameterList>&|' \
   mirrored_tangential.xml >mirrored_breakage.xml
 expect mirrored_breakage 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored on a Displacement of component y' 'Fracture->Bond Breakage = None'
+# ... and for a law whose state is defined on energy-free points (its registration says so:
+# the elastic law's, not Drucker-Prager's).
+sed -e 's|<ParameterList name="hold2">.*</ParameterList></ParameterList>|</ParameterList>|' \
+  -e 's|<ParameterList name="Materials">|&<Parameter name="Model" type="string" value="Micropolar Drucker-Prager"/><Parameter name="Cohesion" type="double" value="1e5"/>|' \
+  mirrored_tangential.xml >mirrored_plastic.xml
+expect mirrored_plastic 2 'mupm->Boundary Conditions->hold->Boundary Layer Values = Mirrored on a Displacement of component y' 'implemented for mupm->Materials->Model = Micropolar Elastic with'
 # ... and mirrored Displacement for a solid without pore water only (measured unstable with it).
 base '<Parameter name="Boundary Layers" type="Array(string)" value="{-x}"/>' \
   '<Parameter name="Physics" type="string" value="Hydro-Mechanical"/>' |

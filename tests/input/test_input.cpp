@@ -5,6 +5,7 @@
 #include <Teuchos_Array.hpp>
 
 #include "mupm/input/input.hpp"
+#include "mupm/input/law_registry.hpp"
 #include "mupm/input/model.hpp"
 
 namespace mupm {
@@ -375,6 +376,48 @@ TEST(Input, PlaneStress) {
                    "<Parameter name=\"Pressure Integration\" type=\"string\" "
                    "value=\"Semi-Implicit\"/>");
   validate_input(*parse_input(xml(kOk + stress, wet_dp_si)));
+}
+
+// Materials->Model offers the registered laws (include/mupm/input/law_registry.hpp), the first
+// the default; the model points at the registration the input names, whose factory reads the
+// law's own parameters from the model's Materials; a name nobody registered is a logic error.
+TEST(Input, LawRegistry) {
+  const auto& laws = law_registry();
+  ASSERT_EQ(laws.size(), 2u);
+  EXPECT_EQ(laws[0], &law_registration<MicropolarElastic>());
+  EXPECT_EQ(laws[1], &law_registration<MicropolarDruckerPrager<2>>());
+  auto pl = parse_input(xml(kOk));
+  validate_input(*pl);
+  EXPECT_EQ(pl->sublist("Materials").get<std::string>("Model"), laws[0]->name);
+  EXPECT_EQ(model_from_input<2>(*pl).law, laws[0]);
+  for (const LawRegistration* law : laws) {
+    EXPECT_EQ(&law_named(law->name), law);
+    ASSERT_TRUE(law->build2 && law->build3) << law->name;
+    const std::string rest =
+        "<ParameterList name=\"Materials\">"
+        "<Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+        "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+        "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+        "<Parameter name=\"Cohesion\" type=\"double\" value=\"2e4\"/>"
+        "<Parameter name=\"Model\" type=\"string\" value=\"" +
+        std::string(law->name) + "\"/></ParameterList>";
+    auto p = parse_input(xml(kOk, rest));
+    validate_input(*p);
+    const Model<3> m = model_from_input<3>(*p);
+    EXPECT_EQ(m.law, law);
+    EXPECT_EQ(m.materials.get<double>("Cohesion"), 2e4);
+  }
+  // The elastic law's state is defined on slaved layers' energy-free points, the plastic one's
+  // is not; the plastic law needs its state and the second-order work.
+  EXPECT_TRUE(laws[0]->energy_free_points);
+  EXPECT_FALSE(laws[1]->energy_free_points);
+  EXPECT_EQ(laws[0]->field_groups, 0u);
+  EXPECT_EQ(laws[1]->field_groups, unsigned(kGroupPlastic | kGroupSecondOrderWork));
+  EXPECT_THROW(law_named("Micropolar Elastoplastic"), std::logic_error);
+  expect_error(xml(kOk,
+                   "<ParameterList name=\"Materials\"><Parameter name=\"Model\" "
+                   "type=\"string\" value=\"Micropolar Elastoplastic\"/></ParameterList>"),
+               {"Model", "Micropolar Elastic", "Micropolar Drucker-Prager"});
 }
 
 // The point fields a run allocates follow from its modules: the pore water's with a fluid, the

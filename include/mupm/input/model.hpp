@@ -10,12 +10,13 @@
 #include <vector>
 
 #include "mupm/input/input.hpp"
+#include "mupm/input/law_registry.hpp"
 #include "mupm/input/options.hpp"
 #include "mupm/io/checkpoint.hpp"
 #include "mupm/kernels/fluid.hpp"
 #include "mupm/kernels/j_integral.hpp"
 #include "mupm/kernels/solid.hpp"
-#include "mupm/laws/micropolar_drucker_prager.hpp"
+#include "mupm/laws/micropolar_elastic.hpp"
 #include "mupm/mesh/grid.hpp"
 #include "mupm/solvers/linear_solve_settings.hpp"
 
@@ -82,13 +83,15 @@ template <int Dim>
 struct Model {
   GridSpec<Dim> grid;
   RunSettings run;
-  ConstitutiveModel constitutive_model = ConstitutiveModel::MicropolarElastic;
+  // Materials->Model's registration (include/mupm/input/law_registry.hpp), and the validated
+  // Materials, from which its factory reads the law's own parameters.
+  const LawRegistration* law = nullptr;
+  Teuchos::ParameterList materials;
   SolidParams solid;
-  MicropolarElastic material;      // the 3D law (solid.law is its plane_stress() in plane stress)
-  bool plane_stress = false;       // Discretization->Plane = Stress (2D)
-  DruckerPragerParams plasticity;  // Materials->Model = Micropolar Drucker-Prager
-  double solid_density = 2000;     // rho_s
-  double damping = 0;              // Solver->Damping
+  MicropolarElastic material;   // the 3D law (solid.law is its plane_stress() in plane stress)
+  bool plane_stress = false;    // Discretization->Plane = Stress (2D)
+  double solid_density = 2000;  // rho_s
+  double damping = 0;           // Solver->Damping
   FluidParams fluid;
   FractureParams fracture;
   JIntegralParams j_integral;          // no contours: no J

@@ -1,9 +1,9 @@
 // Enumerated input options, typed once: each option's strings and enum values are one table,
 // from which the input's validator (Teuchos StringToIntegralParameterEntryValidator, so
 // --print-defaults lists the choices) and the conversion to the enum both follow. The tables are
-// in src/input/model.cpp, but for Materials->Model (the laws' entries, src/input/modules/
-// materials.cpp) and Boundary Conditions->NAME->Type (the kinds' entries, modules/conditions.cpp).
-// Below the input layer nobody compares option strings.
+// in src/input/model.cpp, but for Boundary Conditions->NAME->Type (the kinds' entries,
+// src/input/modules/conditions.cpp). Materials->Model's laws are registrations
+// (include/mupm/input/law_registry.hpp). Below the input layer nobody compares option strings.
 #ifndef MUPM_OPTIONS_HPP
 #define MUPM_OPTIONS_HPP
 
@@ -30,8 +30,6 @@ inline bool has_fluid(Physics p) {
 enum class Staggering { SolidFirst, FluidFirst };
 // Solver->Pressure Integration.
 enum class PressureIntegration { Explicit, SemiImplicit };
-// Materials->Model.
-enum class ConstitutiveModel { MicropolarElastic, MicropolarDruckerPrager };
 // Fluid->Retention Model.
 enum class RetentionModel { Saturated, VanGenuchten };
 // Fracture->Bond Energy Force State.
@@ -83,7 +81,6 @@ class Options {
 const Options<Physics>& physics_options();
 const Options<Staggering>& staggering_options();
 const Options<PressureIntegration>& pressure_integration_options();
-const Options<ConstitutiveModel>& constitutive_model_options();
 const Options<StabilizationModulus>& stabilization_modulus_options();
 const Options<RetentionModel>& retention_model_options();
 const Options<BondBreaking>& bond_breaking_options();

@@ -47,7 +47,8 @@ struct SolidSettings {
 };
 
 // Law: the pointwise constitutive law of pass 1 (include/mupm/kernels/solid.hpp), chosen once
-// by the driver from Materials->Model.
+// from Materials->Model: its registration's factory (include/mupm/input/law_registry.hpp)
+// builds the solver.
 template <int Dim, class Law = MicropolarElastic>
 class SolidSolver : public Mechanics, public Skeleton {
  public:

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../laws/solid_build.hpp"
 #include "mupm/input/model.hpp"
 #include "mupm/io/point_rows.hpp"
 #include "mupm/solvers/initial_conditions.hpp"
@@ -104,25 +105,10 @@ Assembly<Dim> assemble(const Model<Dim>& model, Discretization<Dim>& disc, MPI_C
       settings.second_order_window = model.run.second_order_window > 0
                                          ? model.run.second_order_window
                                          : model.run.field_interval;
-    auto attach = [&](auto solid) {
-      if (auto* j = ph.j_integral.get()) {
-        j->attach(solid->state(), solid->params());
-        solid->keep_pore_part();
-      }
-      ph.mechanics = std::move(solid);
-    };
-    switch (model.constitutive_model) {
-      case ConstitutiveModel::MicropolarElastic:
-        attach(std::make_unique<SolidSolver<Dim, MicropolarElastic>>(
-            disc, model.solid, model.boundary_conditions, settings, mpi));
-        break;
-      case ConstitutiveModel::MicropolarDruckerPrager:
-        attach(std::make_unique<SolidSolver<Dim, MicropolarDruckerPrager<Dim>>>(
-            disc, model.solid, model.boundary_conditions, settings, mpi,
-            MicropolarDruckerPrager<Dim>(model.material, model.plasticity, disc.points,
-                                         model.plane_stress, has_fluid(physics))));
-        break;
-    }
+    if (!model.law)
+      throw std::logic_error("a solid without its law (Model::law)");
+    ph.mechanics =
+        model.law->build(SolidBuild<Dim>{model, disc, settings, mpi, ph.j_integral.get()});
   } else if (physics == Physics::KinematicsOnly) {
     ph.mechanics = std::make_unique<Kinematics<Dim>>(disc);
   }
