@@ -311,4 +311,93 @@ InputModule initial_conditions_input() {
           declare_initial_conditions, check_initial_conditions, nullptr};
 }
 
+namespace {
+
+// Region names in bit order: the user's regions, then the boundary layers (as grid_from_input).
+std::vector<std::string> region_names(const ParameterList& input) {
+  const ParameterList& d = input.sublist("Discretization");
+  std::vector<std::string> names;
+  const ParameterList& regions = d.sublist("Regions");
+  for (auto it = regions.begin(); it != regions.end(); ++it)
+    names.push_back(regions.name(it));
+  const int dim = d.get<int>("Dimension");
+  const auto faces = d.get<Array<std::string>>("Boundary Layers");
+  for (int k = 0; k < dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      const std::string f = std::string(side ? "+" : "-") + char('x' + k);
+      for (const auto& g : faces)
+        if (g == f) {
+          names.push_back("Layer " + f);
+          break;
+        }
+    }
+  return names;
+}
+
+std::uint32_t region_mask(const std::vector<std::string>& names, const std::string& region) {
+  for (std::size_t r = 0; r < names.size(); ++r)
+    if (names[r] == region)
+      return 1u << r;
+  return 0;  // All
+}
+
+}  // namespace
+
+// The conditions of the input (include/mupm/input/input.hpp).
+std::vector<InitialCondition> initial_conditions_from_input(const ParameterList& input) {
+  const auto names = region_names(input);
+  std::vector<InitialCondition> out;
+  const ParameterList& ics = input.sublist("Initial Conditions");
+  for (auto it = ics.begin(); it != ics.end(); ++it) {
+    const ParameterList& c = ics.sublist(ics.name(it));
+    InitialCondition ic;
+    ic.name = ics.name(it);
+    ic.field = c.get<std::string>("Field");
+    ic.region_mask = region_mask(names, c.get<std::string>("Region"));
+    const auto v = c.get<Array<double>>("Value");
+    ic.value.assign(v.begin(), v.end());
+    out.push_back(ic);
+  }
+  return out;
+}
+
+std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterList& input) {
+  const auto names = region_names(input);
+  const int dim = input_dimension(input);
+  std::vector<BoundaryCondition> out;
+  const ParameterList& bcs = input.sublist("Boundary Conditions");
+  for (auto it = bcs.begin(); it != bcs.end(); ++it) {
+    const ParameterList& c = bcs.sublist(bcs.name(it));
+    BoundaryCondition bc;
+    bc.name = bcs.name(it);
+    bc.kind = boundary_condition_options()(c.get<std::string>("Type"));
+    bc.region_mask = region_mask(names, c.get<std::string>("Region"));
+    bc.component = component_options()(c.get<std::string>("Component"));
+    // In 2D the only rotation component, about z, is theta's component 0.
+    if ((bc.kind == BoundaryCondition::MicroRotation || bc.kind == BoundaryCondition::BodyCouple) &&
+        dim == 2)
+      bc.component = 0;
+    bc.value = c.get<double>("Value");
+    bc.time.kind = time_function_options()(c.get<std::string>("Time Function"));
+    bc.time.ramp_time = c.get<double>("Ramp Time");
+    const auto t = c.get<Array<double>>("Times"), v = c.get<Array<double>>("Values");
+    bc.time.times.assign(t.begin(), t.end());
+    bc.time.values.assign(v.begin(), v.end());
+    std::string values = c.get<std::string>("Boundary Layer Values");
+    if (values == "Default")
+      values = input.sublist("Discretization").get<std::string>("Boundary Layer Values");
+    // The Discretization's default reaches Pore Pressure only; a Displacement or Micro-Rotation
+    // condition mirrors when it says so itself (input/model.cpp, check_mirrored_kinematic).
+    bc.mirrored = bc.kind == BoundaryCondition::FluidFlux ||
+                  ((bc.kind == BoundaryCondition::PorePressure ||
+                    bc.kind == BoundaryCondition::FracturePressure) &&
+                   values == "Mirrored") ||
+                  (bc.kinematic() && c.get<std::string>("Boundary Layer Values") == "Mirrored");
+    bc.consistent = bc.kind == BoundaryCondition::Traction &&
+                    c.get<std::string>("Traction Distribution") == "Consistent";
+    out.push_back(bc);
+  }
+  return out;
+}
+
 }  // namespace mupm

@@ -255,4 +255,87 @@ InputModule discretization_input() {
           declare_discretization, check_discretization, nullptr};
 }
 
+// The grid of Discretization (include/mupm/input/input.hpp).
+template <int Dim>
+GridSpec<Dim> grid_from_input(const ParameterList& input) {
+  const ParameterList& d = input.sublist("Discretization");
+  GridSpec<Dim> g;
+  g.dx = d.get<double>("Spacing");
+  g.horizon = horizon_of(d);
+  g.thickness = Dim == 2 ? d.get<double>("Thickness") : 1.0;
+  const auto counts = d.get<Array<int>>("Counts");
+  const auto ext = d.get<Array<double>>("Extents");
+  const auto origin = d.get<Array<double>>("Origin");
+  for (int k = 0; k < Dim; ++k) {
+    g.counts[k] = counts.empty() ? std::llround(ext[k] / g.dx) : counts[k];
+    g.origin[k] = origin.empty() ? 0.0 : origin[k];
+  }
+  // check_layer_rows has bounded it.
+  const int rows = static_cast<int>(layer_rows(d, d.get<double>("Boundary Layer Horizons")));
+  for (const auto& f : d.get<Array<std::string>>("Boundary Layers"))
+    g.layers[f[1] - 'x'][f[0] == '-' ? 0 : 1] = rows;
+  const ParameterList& regions = d.sublist("Regions");
+  for (auto it = regions.begin(); it != regions.end(); ++it) {
+    const ParameterList& r = regions.sublist(regions.name(it));
+    Box b;
+    const auto lo = r.get<Array<double>>("Min"), hi = r.get<Array<double>>("Max");
+    for (int k = 0; k < Dim; ++k) {
+      b.lo[k] = lo[k];
+      b.hi[k] = hi[k];
+    }
+    g.region_names.push_back(regions.name(it));
+    g.regions.push_back(b);
+  }
+  // Boundary layers as regions: the rows outside the face, across the whole lattice.
+  for (int k = 0; k < Dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      if (g.layers[k][side] == 0)
+        continue;
+      Box b;
+      for (int j = 0; j < Dim; ++j) {
+        b.lo[j] = g.origin[j] - (g.layers[j][0] + 1) * g.dx;
+        b.hi[j] = g.origin[j] + (g.counts[j] + g.layers[j][1] + 1) * g.dx;
+      }
+      const double lo_face = g.origin[k], hi_face = g.origin[k] + g.counts[k] * g.dx;
+      if (side == 0)
+        b.hi[k] = lo_face - 0.25 * g.dx;
+      else
+        b.lo[k] = hi_face + 0.25 * g.dx;
+      g.region_names.push_back(std::string("Layer ") + (side ? '+' : '-') + char('x' + k));
+      g.regions.push_back(b);
+    }
+  const ParameterList& cracks = d.sublist("Pre-Cracks");
+  for (auto it = cracks.begin(); it != cracks.end(); ++it) {
+    const ParameterList& c = cracks.sublist(cracks.name(it));
+    Crack cr;
+    if (Dim == 2) {
+      const auto a = c.get<Array<double>>("Start"), b = c.get<Array<double>>("End");
+      for (int k = 0; k < 2; ++k) {
+        cr.a[k] = a[k];
+        cr.b[k] = b[k];
+      }
+    } else {
+      const auto a = c.get<Array<double>>("Corner"), e1 = c.get<Array<double>>("Edge 1"),
+                 e2 = c.get<Array<double>>("Edge 2");
+      for (int k = 0; k < 3; ++k) {
+        cr.a[k] = a[k];
+        cr.b[k] = e1[k];
+        cr.c[k] = e2[k];
+      }
+    }
+    // A crack that misses the body breaks no bond and would measure no length.
+    const CrackPart part = crack_inside<Dim>(cr, g.body());
+    if (!(part.s1 > part.s0))
+      throw InputError("Error, " + c.name() +
+                       " lies outside the body (or touches it in a point or along its surface "
+                       "only): it would cut no bond. Check its coordinates against the body, "
+                       "which spans Origin to Origin + Counts x Spacing.");
+    g.cracks.push_back(cr);
+  }
+  return g;
+}
+
+template GridSpec<2> grid_from_input<2>(const ParameterList&);
+template GridSpec<3> grid_from_input<3>(const ParameterList&);
+
 }  // namespace mupm
