@@ -2,6 +2,8 @@
 // of its own (src/input/modules/): its parameters with their defaults, doc strings and
 // validators; the checks Teuchos' validators cannot make (across parameters and sublists); and
 // the point-field groups (include/mupm/data/fields.hpp) it makes a run allocate.
+// Discretization's and the conditions' files also hold their conversion for the model
+// (grid_from_input, initial_conditions_from_input, boundary_conditions_from_input).
 // valid_parameters, validate_input and point_field_groups (src/input/input.cpp) follow from the
 // list of modules, input_modules(). Private to the input layer and the constitutive laws'
 // registrations (src/solvers/laws/), which declare their parameters with its helpers.

@@ -6,8 +6,6 @@
 
 #include <Teuchos_Array.hpp>
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <sstream>
 

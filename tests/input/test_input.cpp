@@ -403,7 +403,7 @@ TEST(Input, LawRegistry) {
         std::string(law->name) + "\"/></ParameterList>";
     auto p = parse_input(xml(kOk, rest));
     validate_input(*p);
-    const Model<3> m = model_from_input<3>(*p);
+    const Model<2> m = model_from_input<2>(*p);
     EXPECT_EQ(m.law, law);
     EXPECT_EQ(m.materials.get<double>("Cohesion"), 2e4);
   }

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "../../src/solvers/laws/solid_build.hpp"
+#include "mupm/input/input.hpp"
 #include "mupm/input/model.hpp"
 #include "mupm/solvers/solid_solver.hpp"
 #include "test_utils.hpp"
@@ -665,6 +667,72 @@ TEST(SolidSolver, StableStepEstimate) {
   // measured here: 1.4 at 0.8, 1.6 at 0.9, 2.0 at 0.95, 2.5 at 0.99; NaN at 1.05.
   EXPECT_LT(below, 10.0);
   EXPECT_TRUE(!(above < 1e3)) << above;  // exponential growth (or Inf/NaN)
+}
+
+// Each law's registration (include/mupm/input/law_registry.hpp) builds the solid solver of its
+// law from the model, with the law's own parameters of Materials: Drucker-Prager's angles in
+// radians, its cohesions and softening modulus, the 3D elastic law; the elastic law is the
+// model's.
+template <int Dim>
+void check_law_factories() {
+  const std::string counts = Dim == 2 ? "{8, 6}" : "{6, 5, 4}";
+  auto input = [&](const std::string& law) {
+    return "<ParameterList name=\"mupm\"><ParameterList name=\"Discretization\">"
+           "<Parameter name=\"Dimension\" type=\"int\" value=\"" +
+           std::to_string(Dim) +
+           "\"/><Parameter name=\"Spacing\" type=\"double\" value=\"0.01\"/>"
+           "<Parameter name=\"Counts\" type=\"Array(int)\" value=\"" +
+           counts +
+           "\"/></ParameterList><ParameterList name=\"Materials\">"
+           "<Parameter name=\"Model\" type=\"string\" value=\"" +
+           law +
+           "\"/><Parameter name=\"Bulk Modulus\" type=\"double\" value=\"1e8\"/>"
+           "<Parameter name=\"Shear Modulus\" type=\"double\" value=\"5e7\"/>"
+           "<Parameter name=\"Length Scale\" type=\"double\" value=\"1e-3\"/>"
+           "<Parameter name=\"Friction Angle\" type=\"double\" value=\"30\"/>"
+           "<Parameter name=\"Dilation Angle\" type=\"double\" value=\"12\"/>"
+           "<Parameter name=\"Cohesion\" type=\"double\" value=\"2e4\"/>"
+           "<Parameter name=\"Residual Cohesion\" type=\"double\" value=\"5e3\"/>"
+           "<Parameter name=\"Softening Modulus\" type=\"double\" value=\"-3e5\"/>"
+           "</ParameterList></ParameterList>";
+  };
+  auto build = [](const Model<Dim>& m, Discretization<Dim>& disc) {
+    SolidSettings settings;
+    return m.law->build(SolidBuild<Dim>{m, disc, settings, MPI_COMM_WORLD, nullptr});
+  };
+  {
+    auto pl = parse_input(input("Micropolar Elastic"));
+    validate_input(*pl);
+    const Model<Dim> m = model_from_input<Dim>(*pl);
+    auto disc = discretize(test::world(), m.grid, m.run.field_groups);
+    auto solid = build(m, disc);
+    auto* el = dynamic_cast<SolidSolver<Dim, MicropolarElastic>*>(solid.get());
+    ASSERT_NE(el, nullptr);
+    EXPECT_EQ(el->law().lambda, m.solid.law.lambda);
+    EXPECT_EQ(el->law().mu, m.solid.law.mu);
+  }
+  auto pl = parse_input(input("Micropolar Drucker-Prager"));
+  validate_input(*pl);
+  const Model<Dim> m = model_from_input<Dim>(*pl);
+  auto disc = discretize(test::world(), m.grid, m.run.field_groups);
+  auto solid = build(m, disc);
+  using Elastic = SolidSolver<Dim, MicropolarElastic>;
+  EXPECT_EQ(dynamic_cast<Elastic*>(solid.get()), nullptr);
+  auto* dp = dynamic_cast<SolidSolver<Dim, MicropolarDruckerPrager<Dim>>*>(solid.get());
+  ASSERT_NE(dp, nullptr);
+  const DruckerPragerParams& d = dp->law().dp;
+  EXPECT_DOUBLE_EQ(d.friction, kPi / 6);
+  EXPECT_DOUBLE_EQ(d.dilation, 12 * kPi / 180);
+  EXPECT_EQ(d.cohesion, 2e4);
+  EXPECT_EQ(d.residual, 5e3);
+  EXPECT_EQ(d.softening, -3e5);
+  EXPECT_EQ(dp->law().elastic.mu, m.material.mu);
+  EXPECT_EQ(dp->law().elastic.lambda, m.material.lambda);
+  EXPECT_FALSE(dp->law().plane_stress);
+}
+TEST(SolidSolver, LawFactories) {
+  check_law_factories<2>();
+  check_law_factories<3>();
 }
 
 }  // namespace

@@ -81,9 +81,9 @@ MemoryNeed check_memory(const Teuchos::Comm<int>& comm, const Teuchos::Parameter
 void check_files(const Teuchos::Comm<int>& comm, const Teuchos::ParameterList& input);
 
 // The point-field groups (FieldGroup, include/mupm/data/fields.hpp) a run of this input
-// allocates: those of its modules (a fluid: pore water; Fracture Flow: crack water; Micropolar
-// Drucker-Prager: plastic and second-order work) and of every field Output->Fields names
-// (second_order_work there also turns the second-order work on).
+// allocates, of a validated input: those of its modules (a fluid: pore water; Fracture Flow:
+// crack water; Micropolar Drucker-Prager: plastic and second-order work) and of every field
+// Output->Fields names (second_order_work there also turns the second-order work on).
 unsigned point_field_groups(const Teuchos::ParameterList& input);
 
 // Names of the point fields that can be written (Output->Fields).

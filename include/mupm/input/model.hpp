@@ -1,5 +1,7 @@
 // The model an input describes, as the plain structs the lower layers take, built in one place
-// (model_from_input) from the validated parameter list. The parameter builders below derive the
+// (model_from_input) from the validated parameter list; but for a constitutive law's own
+// parameters, which its registration's factory reads from Model::materials
+// (include/mupm/input/law_registry.hpp). The parameter builders below derive the
 // constants that depend on the grid (stabilization modulus, family volume and second moment);
 // tests and benchmarks call them too, so every caller gets the same constants.
 #ifndef MUPM_MODEL_HPP

@@ -69,6 +69,7 @@ class SolidSolver : public Mechanics, public Skeleton {
 
   const SolidState<Dim>& state() const { return st_; }
   const SolidParams& params() const { return prm_; }
+  const Law& law() const { return law_; }
   const Scalars& density() const { return rho_; }
 
   const char* name() const override { return "solid"; }

@@ -1,7 +1,5 @@
 // Materials->Model = Micropolar Drucker-Prager (include/mupm/laws/micropolar_drucker_prager.hpp):
 // its parameters in Materials, their checks, its point fields and its solver.
-#include <cmath>
-
 #include "../../input/input_module.hpp"
 #include "mupm/core/types.hpp"
 #include "mupm/data/fields.hpp"
@@ -45,19 +43,6 @@ void check(const ParameterList& m) {
                      " Pa: softening ends at the residual cohesion.");
 }
 
-// psi > phi: the plastic dissipation per d lambda, q + sqrt3 a3 p-bar = k c + sqrt3 (a3 - a1)
-// p-bar on the yield surface (the law's header), turns negative under a mean compression -p-bar
-// beyond k c / (sqrt3 (a3 - a1)).
-void warn(const ParameterList& m, std::vector<std::string>& warnings) {
-  const double phi = m.get<double>("Friction Angle"), psi = m.get<double>("Dilation Angle");
-  if (psi > phi)
-    warnings.push_back("mupm->Materials->Dilation Angle = " + exact(psi) +
-                       " exceeds Friction Angle = " + exact(phi) +
-                       " degrees: the plastic dissipation turns negative (energy made by plastic "
-                       "flow) under a mean compressive stress beyond k c / (sqrt3 (a3 - a1)) "
-                       "(eqs 87-91); soils have psi <= phi");
-}
-
 DruckerPragerParams params(const ParameterList& m) {
   const double deg = kPi / 180;
   DruckerPragerParams d;
@@ -67,6 +52,19 @@ DruckerPragerParams params(const ParameterList& m) {
   d.residual = m.get<double>("Residual Cohesion");
   d.softening = m.get<double>("Softening Modulus");
   return d;
+}
+
+// psi > phi: the plastic dissipation per d lambda, q + sqrt3 a3 p-bar = k c + sqrt3 (a3 - a1)
+// p-bar on the yield surface (the law's header), turns negative under a mean compression -p-bar
+// beyond k c / (sqrt3 (a3 - a1)).
+void warn(const ParameterList& m, std::vector<std::string>& warnings) {
+  const double phi = m.get<double>("Friction Angle"), psi = m.get<double>("Dilation Angle");
+  if (params(m).dilation > params(m).friction)
+    warnings.push_back("mupm->Materials->Dilation Angle = " + exact(psi) +
+                       " exceeds Friction Angle = " + exact(phi) +
+                       " degrees: the plastic dissipation turns negative (energy made by plastic "
+                       "flow) under a mean compressive stress beyond k c / (sqrt3 (a3 - a1)) "
+                       "(eqs 87-91); soils have psi <= phi");
 }
 
 // The return is 3D in plane stress too: the 3D law (model.material), not solid.law.

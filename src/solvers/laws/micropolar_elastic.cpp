@@ -7,7 +7,9 @@ namespace {
 
 template <int Dim>
 std::unique_ptr<Mechanics> build(const SolidBuild<Dim>& b) {
-  return solid_module(b, b.model.solid.law);  // in plane stress, its plane_stress() (model.cpp)
+  // The solver takes the elastic law of its SolidParams (in plane stress the law's
+  // plane_stress(), model_from_input); the same is passed here.
+  return solid_module(b, b.model.solid.law);
 }
 
 }  // namespace
