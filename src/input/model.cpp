@@ -196,15 +196,16 @@ void check_mirrored_kinematic(const GridSpec<Dim>& g, std::vector<BoundaryCondit
                                   ? std::string()
                                   : std::string(" of component ") + axes[bc.component]) +
                              " slaves its layer (energy-free points)";
-    std::vector<std::string> laws;
-    for (const LawRegistration* l : law_registry())
-      if (l->energy_free_points)
-        laws.push_back(l->name);
-    if (!law.energy_free_points || breaking != BondBreaking::None)
+    if (!law.energy_free_points || breaking != BondBreaking::None) {
+      std::vector<std::string> laws;  // those that run with slaved layers
+      for (const LawRegistration* l : law_registry())
+        if (l->energy_free_points)
+          laws.push_back(l->name);
       throw InputError("Error, " + path + what + ", which is implemented for " + root +
                        "->Materials->Model = " + joined(laws) + " with " + root +
                        "->Fracture->Bond Breakage = None only; write Constant, or mirror the "
                        "normal Displacement alone (a symmetry plane).");
+    }
     if (j_contours)
       throw InputError("Error, " + path + what + ", and the J-integral's contours (" + root +
                        "->J-Integral->Half Widths) may reach into them, where the states are "

@@ -59,7 +59,8 @@ DruckerPragerParams params(const ParameterList& m) {
 // beyond k c / (sqrt3 (a3 - a1)).
 void warn(const ParameterList& m, std::vector<std::string>& warnings) {
   const double phi = m.get<double>("Friction Angle"), psi = m.get<double>("Dilation Angle");
-  if (params(m).dilation > params(m).friction)
+  const DruckerPragerParams d = params(m);
+  if (d.dilation > d.friction)
     warnings.push_back("mupm->Materials->Dilation Angle = " + exact(psi) +
                        " exceeds Friction Angle = " + exact(phi) +
                        " degrees: the plastic dissipation turns negative (energy made by plastic "
