@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <mutex>
 #include <unordered_map>
 
 namespace mupm::timers {
@@ -22,6 +23,7 @@ struct State {
   bool enabled = false;
   bool in_loop = false;                                        // time_loop(true) .. (false)
   std::map<std::string, std::pair<long long, double>> allocs;  // in the loop: count, bytes
+  std::mutex allocs_lock;
 };
 State& state() {
   static State s;
@@ -71,10 +73,14 @@ void pop_region() {
   ++s.entries[k].calls;
 }
 
+// Kokkos calls this from every thread of the pool at once when an OpenMP reduction or team
+// needs more scratch (OpenMPExec::resize_thread_data allocates each thread's block in its own
+// thread), so the tally is locked. The kernel and region callbacks come from the master only.
 void allocate(Kokkos::Tools::SpaceHandle, const char* label, const void*, std::uint64_t bytes) {
   State& s = state();
   if (!s.in_loop)
     return;
+  const std::lock_guard<std::mutex> hold(s.allocs_lock);
   auto& a = s.allocs[label && *label ? label : "(unlabelled)"];
   ++a.first;
   a.second += double(bytes);
@@ -87,6 +93,7 @@ void time_loop(bool inside) {
 }
 
 long long loop_allocations() {
+  const std::lock_guard<std::mutex> hold(state().allocs_lock);
   long long n = 0;
   for (const auto& a : state().allocs)
     n += a.second.first;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <string>
 
 #include "mupm/core/exact_sum.hpp"
 #include "mupm/core/timers.hpp"
@@ -128,6 +129,28 @@ TEST(Distribution, RefreshOfKnownWidthsAllocatesNothing) {
   timers::disable();
   EXPECT_EQ(during_refreshes, 0);
   EXPECT_EQ(with_one, 1);
+}
+
+// Kokkos allocates each OpenMP thread's scratch in that thread (a reduction whose scratch grows
+// inside the time loop), so the allocation counter is called from all threads at once: it counts
+// every call, and neither crashes nor loses one. The concurrent calls are made directly, many of
+// them with labels new to the tally, as the pool's own resize makes too few to race reliably.
+TEST(Distribution, AllocationCounterTakesConcurrentCalls) {
+  if (!timers::enable())
+    GTEST_SKIP() << "an external Kokkos tool holds the callbacks";
+  timers::reset();
+  timers::time_loop(true);
+  constexpr int calls = 40000;
+  const auto host = Kokkos::Profiling::make_space_handle(Kokkos::HostSpace::name());
+  Kokkos::parallel_for(
+      "concurrent_allocations", Kokkos::RangePolicy<Kokkos::DefaultHostExecutionSpace>(0, calls),
+      [=](int i) {
+        Kokkos::Profiling::allocateData(host, "label " + std::to_string(i % 4000), nullptr, 8);
+      });
+  const long long counted = timers::loop_allocations();
+  timers::time_loop(false);
+  timers::disable();
+  EXPECT_EQ(counted, calls);
 }
 
 TEST(Distribution, LayerMirrors2D) {
