@@ -78,6 +78,10 @@ Teuchos::Array<T> get_array(const Teuchos::ParameterList& l, const std::string& 
 double horizon_of(const Teuchos::ParameterList& discretization);
 // Rows of a boundary layer `horizons` horizons thick: floor(horizons delta / dx) (grid_from_input).
 double layer_rows(const Teuchos::ParameterList& discretization, double horizons);
+// The names of Discretization's regions in the order of their bits in a condition's region mask
+// (GridSpec::region_names): its Regions, then the boundary layers it asks for ('Layer -x', ...)
+// by axis and side. Of a validated input (each listed face then has at least one row).
+std::vector<std::string> region_names(const Teuchos::ParameterList& discretization);
 
 }  // namespace mupm
 

@@ -313,27 +313,7 @@ InputModule initial_conditions_input() {
 
 namespace {
 
-// Region names in bit order: the user's regions, then the boundary layers (as grid_from_input).
-std::vector<std::string> region_names(const ParameterList& input) {
-  const ParameterList& d = input.sublist("Discretization");
-  std::vector<std::string> names;
-  const ParameterList& regions = d.sublist("Regions");
-  for (auto it = regions.begin(); it != regions.end(); ++it)
-    names.push_back(regions.name(it));
-  const int dim = d.get<int>("Dimension");
-  const auto faces = d.get<Array<std::string>>("Boundary Layers");
-  for (int k = 0; k < dim; ++k)
-    for (int side = 0; side < 2; ++side) {
-      const std::string f = std::string(side ? "+" : "-") + char('x' + k);
-      for (const auto& g : faces)
-        if (g == f) {
-          names.push_back("Layer " + f);
-          break;
-        }
-    }
-  return names;
-}
-
+// The bit of a condition's Region among names (region_names); All: none.
 std::uint32_t region_mask(const std::vector<std::string>& names, const std::string& region) {
   for (std::size_t r = 0; r < names.size(); ++r)
     if (names[r] == region)
@@ -345,7 +325,7 @@ std::uint32_t region_mask(const std::vector<std::string>& names, const std::stri
 
 // The conditions of the input (include/mupm/input/input.hpp).
 std::vector<InitialCondition> initial_conditions_from_input(const ParameterList& input) {
-  const auto names = region_names(input);
+  const auto names = region_names(input.sublist("Discretization"));
   std::vector<InitialCondition> out;
   const ParameterList& ics = input.sublist("Initial Conditions");
   for (auto it = ics.begin(); it != ics.end(); ++it) {
@@ -362,7 +342,7 @@ std::vector<InitialCondition> initial_conditions_from_input(const ParameterList&
 }
 
 std::vector<BoundaryCondition> boundary_conditions_from_input(const ParameterList& input) {
-  const auto names = region_names(input);
+  const auto names = region_names(input.sublist("Discretization"));
   const int dim = input_dimension(input);
   std::vector<BoundaryCondition> out;
   const ParameterList& bcs = input.sublist("Boundary Conditions");

@@ -1,5 +1,6 @@
 #include "../input_module.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "mupm/input/options.hpp"
@@ -255,6 +256,22 @@ InputModule discretization_input() {
           declare_discretization, check_discretization, nullptr};
 }
 
+std::vector<std::string> region_names(const ParameterList& d) {
+  std::vector<std::string> names;
+  const ParameterList& regions = d.sublist("Regions");
+  for (auto it = regions.begin(); it != regions.end(); ++it)
+    names.push_back(regions.name(it));
+  const int dim = d.get<int>("Dimension");
+  const auto faces = d.get<Array<std::string>>("Boundary Layers");
+  for (int k = 0; k < dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      const std::string f = std::string(side ? "+" : "-") + char('x' + k);
+      if (std::find(faces.begin(), faces.end(), f) != faces.end())
+        names.push_back("Layer " + f);
+    }
+  return names;
+}
+
 // The grid of Discretization (include/mupm/input/input.hpp).
 template <int Dim>
 GridSpec<Dim> grid_from_input(const ParameterList& input) {
@@ -283,7 +300,6 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
       b.lo[k] = lo[k];
       b.hi[k] = hi[k];
     }
-    g.region_names.push_back(regions.name(it));
     g.regions.push_back(b);
   }
   // Boundary layers as regions: the rows outside the face, across the whole lattice.
@@ -301,9 +317,9 @@ GridSpec<Dim> grid_from_input(const ParameterList& input) {
         b.hi[k] = lo_face - 0.25 * g.dx;
       else
         b.lo[k] = hi_face + 0.25 * g.dx;
-      g.region_names.push_back(std::string("Layer ") + (side ? '+' : '-') + char('x' + k));
       g.regions.push_back(b);
     }
+  g.region_names = region_names(d);  // in the boxes' order
   const ParameterList& cracks = d.sublist("Pre-Cracks");
   for (auto it = cracks.begin(); it != cracks.end(); ++it) {
     const ParameterList& c = cracks.sublist(cracks.name(it));
