@@ -13,13 +13,14 @@
 #
 # Usage: bash cmake/setup.sh            (all of the above)
 #        MUPM_SKIP_APT=1 bash cmake/setup.sh   (skip package installation)
+#        MUPM_TRILINOS_EXTRA='-D...' bash cmake/setup.sh   (a Trilinos with further options)
 set -euo pipefail
 
 log() { printf '[mupm setup] %s\n' "$*" >&2; }
 
 TRILINOS_VERSION=13.2.0
 PACKAGES=(cmake make g++ pkg-config libopenmpi-dev openmpi-bin libhdf5-openmpi-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libblas-dev liblapack-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libblas-dev liblapack-dev libhypre64m-dev
   python3 python3-matplotlib python3-h5py python3-numpy clang-format)
 
 # ---------------------------------------------------------------- packages
@@ -59,6 +60,10 @@ TRILINOS_OPTIONS=(
   -DTpetra_INST_INT_LONG_LONG=ON -DTpetra_INST_COMPLEX_DOUBLE=OFF -DTpetra_INST_FLOAT=OFF
   -DTpetra_ENABLE_DEPRECATED_CODE=OFF -DTrilinos_ENABLE_Fortran=OFF
 )
+# MUPM_TRILINOS_EXTRA: further options (a separate cached build, e.g. for the MueLu measurements of
+# perf/README.md, "Semi-implicit pressure solve"); empty by default, leaving the options' hash.
+# shellcheck disable=SC2206
+TRILINOS_OPTIONS+=(${MUPM_TRILINOS_EXTRA:-})
 
 find_existing_trilinos() {
   local IFS=':;'

@@ -335,6 +335,16 @@ Model<Dim> model_from_input(const ParameterList& input) {
     r.pressure_solve.tolerance = ps.get<double>("Tolerance");
     r.pressure_solve.max_iterations = ps.get<int>("Maximum Iterations");
     r.pressure_solve.recycle = ps.get<int>("Recycled Vectors");
+    r.pressure_solve.refresh_growth = ps.get<double>("Refresh Iteration Growth");
+    r.pressure_solve.amg_strong_threshold = ps.get<double>("AMG Strong Threshold");
+    r.pressure_solve.amg_interpolation_entries = ps.get<int>("AMG Interpolation Entries");
+    r.pressure_solve.amg_aggressive_levels = ps.get<int>("AMG Aggressive Levels");
+    r.pressure_solve.amg_fallback = ps.get<bool>("AMG Fallback");
+    const int write = input.sublist("Diagnostics").get<int>("Write Pressure System");
+    if (write > 0) {
+      r.pressure_solve.write_at = write;
+      r.pressure_solve.write_prefix = input.sublist("Output").get<std::string>("Folder") + "/";
+    }
   }
   r.time_step = solver.get<double>("Time Step");
   r.automatic_time_step = solver.get<bool>("Automatic Time Step");

@@ -5,6 +5,7 @@
 #include <BelosSolverFactory.hpp>
 #include <BelosTpetraAdapter.hpp>
 #include <Ifpack2_Factory.hpp>
+#include <MatrixMarket_Tpetra.hpp>
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_ParameterList.hpp>
 #include <Tpetra_Import.hpp>
@@ -14,6 +15,7 @@
 #include <stdexcept>
 
 #include "mupm/core/timers.hpp"
+#include "mupm/solvers/amg_preconditioner.hpp"
 
 namespace mupm {
 
@@ -24,14 +26,16 @@ using RowMatrix = Tpetra::RowMatrix<double, LocalId, GlobalId>;
 using Preconditioner = Ifpack2::Preconditioner<double, LocalId, GlobalId>;
 
 // Runs f on every rank; true when it threw on any. Decided together, so that every rank then
-// takes the same path.
+// takes the same path. `what`: the exception's text on a rank where it threw.
 template <class F>
-bool fails_anywhere(const Teuchos::Comm<int>& comm, F&& f) {
+bool fails_anywhere(const Teuchos::Comm<int>& comm, F&& f, std::string* what = nullptr) {
   int failed = 0, anywhere = 0;
   try {
     f();
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
     failed = 1;
+    if (what)
+      *what = e.what();
   }
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, failed, Teuchos::outArg(anywhere));
   return anywhere != 0;
@@ -91,6 +95,7 @@ struct LinearSolve::Impl {
   Teuchos::RCP<Teuchos::ParameterList> params;
   Teuchos::RCP<const CrsMatrix> a;
   Teuchos::RCP<Preconditioner> prec;
+  Teuchos::RCP<AmgPreconditioner> amg;
   Teuchos::RCP<const CrsMatrix> pm;  // the matrix prec was computed from
   Teuchos::RCP<Belos::LinearProblem<double, MV, OP>> problem;
   Teuchos::RCP<Belos::SolverManager<double, MV, OP>> solver;
@@ -100,10 +105,10 @@ struct LinearSolve::Impl {
 
 LinearSolve::LinearSolve(const LinearSolveSettings& settings)
     : set_(settings), impl_(Teuchos::rcp(new Impl)) {
-  if (set_.preconditioner != "ILU" && set_.preconditioner != "Jacobi" &&
-      set_.preconditioner != "None")
+  if (set_.preconditioner != "AMG" && set_.preconditioner != "ILU" &&
+      set_.preconditioner != "Jacobi" && set_.preconditioner != "None")
     throw std::invalid_argument("LinearSolve: preconditioner '" + set_.preconditioner +
-                                "' is not ILU, Jacobi or None");
+                                "' is not AMG, ILU, Jacobi or None");
   if (set_.method != "GMRES" && set_.method != "CG")
     throw std::invalid_argument("LinearSolve: method '" + set_.method + "' is not GMRES or CG");
   auto params = Teuchos::parameterList();
@@ -116,8 +121,12 @@ LinearSolve::LinearSolve(const LinearSolveSettings& settings)
     throw std::invalid_argument("LinearSolve: a recycle space of " + std::to_string(set_.recycle) +
                                 " vectors");
   if (method() == "RCG") {
+    if (set_.recycle >= kRcgCycle)
+      throw std::invalid_argument("LinearSolve: a recycle space of " +
+                                  std::to_string(set_.recycle) + " vectors; at most " +
+                                  std::to_string(kRcgCycle - 1) + " (Belos' RCG cycle)");
     // RCG's convergence test is relative to the initial residual, which solve() computes.
-    params->set("Num Blocks", 25);
+    params->set("Num Blocks", kRcgCycle);
     params->set("Num Recycled Blocks", set_.recycle);
   } else if (set_.method == "GMRES") {
     params->set("Num Blocks", set_.restart);
@@ -153,6 +162,10 @@ Teuchos::RCP<const CrsMatrix> LinearSolve::preconditioner_matrix() const {
   return impl_->pm;
 }
 
+Teuchos::RCP<const AmgPreconditioner> LinearSolve::amg() const {
+  return impl_->amg;
+}
+
 void LinearSolve::set_matrix(const Teuchos::RCP<const CrsMatrix>& a) {
   ScopedRegion region("mupm::LinearSolve::setup");
   impl_->a = a;
@@ -162,6 +175,7 @@ void LinearSolve::set_matrix(const Teuchos::RCP<const CrsMatrix>& a) {
   impl_->problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>());
   impl_->problem->setOperator(a);
   jacobi_ = set_.preconditioner == "Jacobi";
+  ilu_ = false;
   precondition();
   ++setups_;
   kept_ = 0;
@@ -172,8 +186,12 @@ void LinearSolve::refresh() {
   ScopedRegion region("mupm::LinearSolve::refresh");
   if (impl_->a.is_null())
     throw std::logic_error("LinearSolve::refresh before set_matrix");
-  // Kept factors: the same decision on every rank (the calls and renewals are collective).
-  if (!renew_ && ++kept_ < set_.refresh_interval)
+  // Kept factors: the same decision on every rank (the calls and renewals are collective, the
+  // iteration counts global). Stale: the last solve took more than refresh_growth times the
+  // first after the set-up.
+  const bool stale = set_.refresh_growth > 0 && base_iterations_ > 0 &&
+                     last_iterations_ > set_.refresh_growth * base_iterations_;
+  if (!renew_ && !stale && ++kept_ < set_.refresh_interval)
     return;
   kept_ = 0;
   renew_ = false;
@@ -184,8 +202,9 @@ void LinearSolve::refresh() {
   // restart, which calls set_matrix, then takes the same path as the straight run (after an ILU
   // breakdown each step pays a failed ILU solve before Jacobi's).
   const bool jacobi = set_.preconditioner == "Jacobi";
-  if (impl_->prec.is_null() || jacobi_ != jacobi) {
+  if ((impl_->prec.is_null() && impl_->amg.is_null()) || jacobi_ != jacobi || ilu_) {
     jacobi_ = jacobi;
+    ilu_ = false;
     precondition();
     return;
   }
@@ -196,7 +215,7 @@ void LinearSolve::refresh() {
 // drop tolerance, whose pattern follows the values) the whole set-up. An ILU whose factorization
 // throws: Jacobi for these values at once, as precondition() does.
 void LinearSolve::compute_factors() {
-  if (set_.drop_tolerance > 0) {
+  if (set_.drop_tolerance > 0 || !impl_->amg.is_null()) {  // AMG: a new hierarchy
     precondition();
     return;
   }
@@ -217,10 +236,33 @@ void LinearSolve::fall_back_to_jacobi() {
 // An ILU whose factorization throws (a zero pivot caught by Ifpack2) falls back at once.
 void LinearSolve::precondition() {
   impl_->prec = Teuchos::null;
+  impl_->amg = Teuchos::null;
   impl_->pm = Teuchos::null;
+  fresh_ = true;
   if (set_.preconditioner == "None") {
     impl_->problem->setRightPrec(Teuchos::null);
     return;
+  }
+  if (set_.preconditioner == "AMG" && !jacobi_ && !ilu_) {
+    impl_->pm = impl_->a;
+    if (set_.drop_tolerance > 0)
+      impl_->pm = sparsified(*impl_->a, set_.drop_tolerance);
+    auto amg = Teuchos::rcp(new AmgPreconditioner(set_));
+    std::string what = "a set-up failure on another rank";
+    if (!fails_anywhere(
+            *impl_->a->getComm(), [&] { amg->setup(*impl_->pm); }, &what)) {
+      impl_->amg = amg;
+      impl_->problem->setRightPrec(amg);
+      return;
+    }
+    if (!set_.amg_fallback)
+      throw std::runtime_error(
+          "the pressure solve's algebraic multigrid (hypre BoomerAMG) could not be set up: " +
+          what +
+          ". Set Solver->Pressure Solve->AMG Fallback = true to continue with ILU for such "
+          "matrices, or choose Solver->Pressure Solve->Preconditioner = ILU.");
+    ilu_ = true;  // ILU for these values (AMG Fallback)
+    ++fallbacks_;
   }
   for (;;) {
     Teuchos::ParameterList p;
@@ -264,6 +306,12 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
     return r;
   }
   scale = std::max(scale, bn);
+  if (++solves_ == set_.write_at) {
+    using Writer = Tpetra::MatrixMarket::Writer<CrsMatrix>;
+    const std::string n = std::to_string(solves_);
+    Writer::writeSparseFile(set_.write_prefix + "pressure_system_" + n + ".mtx", impl_->a);
+    Writer::writeDenseFile(set_.write_prefix + "pressure_rhs_" + n + ".mtx", b);
+  }
   if (!(bn > 0)) {
     x.putScalar(0.0);
     r.converged = true;
@@ -314,7 +362,12 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
       r.iterations = impl_->solver->getNumIters();
       r.residual = std::numeric_limits<double>::quiet_NaN();
     }
-    if (r.converged || jacobi_ || set_.preconditioner != "ILU")
+    if (r.converged && fresh_)
+      base_iterations_ = r.iterations;
+    fresh_ = false;
+    last_iterations_ = r.iterations;
+    const bool ilu = set_.preconditioner == "ILU" || ilu_;
+    if (r.converged || jacobi_ || (!ilu && !(set_.preconditioner == "AMG" && kept_ > 0)))
       return r;
     if (kept_ > 0) {
       // Factors of earlier values (refresh_interval): first the ILU of these values.

@@ -40,8 +40,13 @@ struct LinearSolveResult {
   bool finite_rhs = true;  // false: b held an inf or NaN, no solve was tried
 };
 
+class AmgPreconditioner;
+
 class LinearSolve {
  public:
+  // Belos' RCG: iterations a cycle, at whose end the recycle space is gathered; a space of at
+  // most kRcgCycle - 1 vectors.
+  static constexpr int kRcgCycle = 25;
   explicit LinearSolve(const LinearSolveSettings& settings);
   ~LinearSolve();
   LinearSolve(const LinearSolve&) = delete;
@@ -72,8 +77,10 @@ class LinearSolve {
   // The matrix the current preconditioner was computed from: the last set_matrix's, or its
   // sparsified copy with a drop tolerance (null before set_matrix; for tests).
   Teuchos::RCP<const CrsMatrix> preconditioner_matrix() const;
+  // The algebraic multigrid in use (null unless Preconditioner = AMG and its set-up succeeded).
+  Teuchos::RCP<const AmgPreconditioner> amg() const;
   // ILU breakdowns since construction, each answered with Jacobi for that matrix's values
-  // (solve()).
+  // (solve()), and AMG set-up failures answered with ILU (amg_fallback).
   long long fallbacks() const { return fallbacks_; }
   // "CG", "RCG" (CG with settings().recycle > 0) or "GMRES".
   std::string method() const;
@@ -92,6 +99,11 @@ class LinearSolve {
   int kept_ = 0;         // refresh() calls since the factors were computed
   bool renew_ = false;
   bool forget_ = false;  // the next solve starts without a recycle space (renew)
+  bool ilu_ = false;     // the current matrix's preconditioner is ILU after an AMG failure
+  // refresh_growth's rule: the first solve's iterations after a set-up, and the last solve's
+  bool fresh_ = true;
+  int base_iterations_ = 0, last_iterations_ = 0;
+  long long solves_ = 0;  // solve() calls with a finite right-hand side
 };
 
 }  // namespace mupm

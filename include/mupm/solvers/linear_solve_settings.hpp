@@ -13,9 +13,11 @@ struct LinearSolveSettings {
   // product, a preconditioner apply and three reductions, GMRES's also an orthogonalization
   // against every earlier vector.
   std::string method = "GMRES";
-  std::string preconditioner = "ILU";  // "ILU" (Ifpack2 RILUK) | "Jacobi" | "None"
-  int fill_level = 0;                  // ILU(k)
-  double tolerance = 1e-11;            // ||b - A x|| / the largest ||b|| so far
+  // "AMG" (hypre BoomerAMG, include/mupm/solvers/amg_preconditioner.hpp) | "ILU" (Ifpack2
+  // RILUK) | "Jacobi" | "None"
+  std::string preconditioner = "ILU";
+  int fill_level = 0;        // ILU(k)
+  double tolerance = 1e-11;  // ||b - A x|| / the largest ||b|| so far
   int max_iterations = 1000;
   int restart = 100;  // GMRES restart length (not used by CG)
   // refresh() computes the preconditioner's numeric part on every refresh_interval-th call
@@ -24,6 +26,10 @@ struct LinearSolveSettings {
   // definite preconditioner serves CG), only its iteration count depends on how close the
   // factors are. 1: every call.
   int refresh_interval = 1;
+  // > 1: refresh() also computes the preconditioner again when the last solve took more than
+  // this many times the iterations of the first solve after its set-up (a kept preconditioner
+  // gone stale: the values drifted). 0: no such rule.
+  double refresh_growth = 0;
   // CG only, > 0: Belos' recycling CG (RCG, Parks et al. 2006) with a recycle space of this many
   // vectors, approximate eigenvectors of the preconditioned matrix's smallest eigenvalues
   // gathered over the solves and deflated from every later one. A sequence of systems with
@@ -39,6 +45,18 @@ struct LinearSolveSettings {
   // entries small: its ILU(0) then costs a quarter of one of A's per apply, for more
   // iterations (perf/README.md).
   double drop_tolerance = 0;
+  // AMG: BoomerAMG's strength threshold (a connection a_ij is strong where -a_ij >= this x the
+  // row's largest -a_ik), its interpolation's largest entries a row, and the number of levels
+  // coarsened aggressively (each a coarser, sparser hierarchy for more iterations).
+  double amg_strong_threshold = 0.25;
+  int amg_interpolation_entries = 4;
+  int amg_aggressive_levels = 0;
+  // AMG: after a set-up failure, ILU for this matrix's values instead of stopping the run.
+  bool amg_fallback = false;
+  // > 0: the write_at-th solve writes its matrix and right-hand side (MatrixMarket, gathered on
+  // rank 0) to <write_prefix>pressure_system_<write_at>.mtx and pressure_rhs_<write_at>.mtx.
+  int write_at = 0;
+  std::string write_prefix;
 };
 
 }  // namespace mupm

@@ -52,6 +52,12 @@ void declare_diagnostics(ParameterList& g) {
         "Print the per-kernel time table (min/max over ranks) at the end of the run.");
   g.set("Check Finite", true,
         "Stop the run when a field holds NaN or Inf, naming the step, global id and position.");
+  g.set("Write Pressure System", 0,
+        "N > 0: the semi-implicit pressure solve's N-th system of the run (matrix, right-hand "
+        "side) is written to Output->Folder as pressure_system_N.mtx and pressure_rhs_N.mtx "
+        "(MatrixMarket, rows in global-id order, gathered on rank 0), for studies of the solve "
+        "outside mupm (perf/bench_pressure_solve). 0: never.",
+        at_least(0));
 }
 
 }  // namespace

@@ -61,16 +61,35 @@ void declare_solver(ParameterList& s) {
     ParameterList& ps = s.sublist(
         "Pressure Solve", false,
         "The linear solve of Pressure Integration = Semi-Implicit (Trilinos: Belos' CG, or "
-        "GMRES where mirrored pressure layers make the system unsymmetric; Ifpack2), "
-        "distributed over the ranks like the points.");
-    ps.set("Preconditioner", std::string("ILU"),
-           "Ifpack2's preconditioner: ILU (RILUK on each rank's rows; a solve that fails with "
-           "it, e.g. at a zero pivot, is repeated with the ILU of the current values if it was "
-           "kept from earlier ones, then with Jacobi for that matrix), Jacobi or None.",
-           one_of({"ILU", "Jacobi", "None"}));
+        "GMRES where mirrored pressure layers make the system unsymmetric; hypre's BoomerAMG "
+        "or Ifpack2), distributed over the ranks like the points.");
+    ps.set("Preconditioner", std::string("AMG"),
+           "AMG: hypre's algebraic multigrid BoomerAMG, one V-cycle per iteration (its "
+           "iterations stay bounded as the body is refined and over ranks; a set-up failure "
+           "stops the run unless AMG Fallback). ILU: Ifpack2's RILUK on each rank's rows (a "
+           "solve that fails with it, e.g. at a zero pivot, is repeated with the ILU of the "
+           "current values if it was kept from earlier ones, then with Jacobi for that "
+           "matrix). Jacobi or None. Measured side by side: perf/README.md.",
+           one_of({"AMG", "ILU", "Jacobi", "None"}));
+    ps.set("AMG Strong Threshold", 0.25,
+           "AMG: BoomerAMG's strength threshold theta in (0, 1): a_ij is a strong connection "
+           "where -a_ij >= theta max_k(-a_ik). Larger: coarser levels grow sparser, for more "
+           "iterations.",
+           rcp(new Teuchos::EnhancedNumberValidator<double>(1e-3, 0.999)));
+    ps.set("AMG Interpolation Entries", 4,
+           "AMG: the interpolation's largest entries kept a row (BoomerAMG's P max "
+           "elements); 0: all.",
+           rcp(new Teuchos::EnhancedNumberValidator<int>(0, 64)));
+    ps.set("AMG Aggressive Levels", 0,
+           "AMG: levels coarsened aggressively (cheaper, sparser hierarchy; more iterations).",
+           rcp(new Teuchos::EnhancedNumberValidator<int>(0, 10)));
+    ps.set("AMG Fallback", false,
+           "AMG: where BoomerAMG's set-up fails, continue with ILU for that matrix's values "
+           "(counted in the log) instead of stopping the run (exit 3).");
     ps.set("ILU Fill Level", 0, "Level of fill k of ILU(k).", at_least(0));
     ps.set("Drop Tolerance", 0.02,
-           "ILU: the factors are of the matrix without its entries |a_ij| < this x "
+           "ILU and AMG: the preconditioner is built from the matrix without its entries |a_ij| < "
+           "this x "
            "sqrt(|a_ii a_jj|), each added to the diagonal (the preconditioner stays symmetric "
            "positive definite; the solve is still of the whole matrix). The projection's "
            "matrix is two horizons wide with small far entries: 0.02 keeps about a quarter "
@@ -85,6 +104,12 @@ void declare_solver(ParameterList& s) {
            "Tolerance on the current matrix, only its iterations depend on it. 1: every "
            "change. A new matrix graph (points joining the network) always computes it.",
            at_least(1));
+    ps.set("Refresh Iteration Growth", 1.5,
+           "When the preconditioner is kept from earlier values (Preconditioner Refresh "
+           "Interval), it is computed again at the next change once a solve takes more than "
+           "this many times the iterations of the first solve after its set-up (values "
+           "drifted). 0: only the interval decides.",
+           rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1e6)));
     ps.set("Tolerance", 1e-11,
            "Residual ||b - A x|| at which the solve stops, relative to the largest right-hand "
            "side ||b|| of the run so far (the water balances of a step): every point's water "
@@ -100,8 +125,9 @@ void declare_solver(ParameterList& s) {
            "preconditioner applies a step become 28, the solve 1.3 times faster with 10, "
            "perf/README.md). The "
            "space is dropped at each checkpoint, so a restart continues bit for bit. Not "
-           "used with GMRES (mirrored pressure layers). 0: CG.",
-           at_least(0));
+           "used with GMRES (mirrored pressure layers). 0: CG. At most 24 (RCG gathers the "
+           "space every 25 iterations).",
+           rcp(new Teuchos::EnhancedNumberValidator<int>(0, 24)));
   }
   s.set("Time Step", 1e-6, "Time step dt [s] (> 0).", positive());
   s.set("Automatic Time Step", false,

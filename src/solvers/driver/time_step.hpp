@@ -153,8 +153,14 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
       out << " with " << ls.recycle << " recycled vectors";
     out << ", " << ls.preconditioner;
     if (ls.preconditioner == "ILU")
-      out << "(" << ls.fill_level << ") of the matrix less its entries below " << ls.drop_tolerance
-          << " of the diagonals' geometric mean, kept up to " << ls.refresh_interval << " steps";
+      out << "(" << ls.fill_level << ")";
+    if (ls.preconditioner == "AMG")
+      out << " (hypre BoomerAMG, strong threshold " << ls.amg_strong_threshold << ")";
+    if (ls.preconditioner == "ILU" || ls.preconditioner == "AMG")
+      out << " of the matrix less its entries below " << ls.drop_tolerance
+          << " of the diagonals' geometric mean, kept up to " << ls.refresh_interval
+          << " steps or until a solve takes " << ls.refresh_growth
+          << " times the iterations of the first after it";
     out << ", tolerance " << ls.tolerance << ")\n";
   }
   if (ph.fluid && !ph.fluid->semi_implicit()) {
