@@ -340,6 +340,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
     r.pressure_solve.amg_interpolation_entries = ps.get<int>("AMG Interpolation Entries");
     r.pressure_solve.amg_aggressive_levels = ps.get<int>("AMG Aggressive Levels");
     r.pressure_solve.amg_fallback = ps.get<bool>("AMG Fallback");
+    r.pressure_solve.amg_drop_tolerance = ps.get<double>("AMG Drop Tolerance");
     const int write = input.sublist("Diagnostics").get<int>("Write Pressure System");
     if (write > 0) {
       r.pressure_solve.write_at = write;

@@ -8,6 +8,8 @@
 #include <Teuchos_DefaultMpiComm.hpp>
 #include <Tpetra_Import.hpp>
 #include <Tpetra_Vector.hpp>
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -53,6 +55,7 @@ struct AmgPreconditioner::Impl {
   HYPRE_ParVector b = nullptr, x = nullptr;
   HYPRE_Solver amg = nullptr;
   LocalId n = 0;
+  double scale = 1;  // the hierarchy is of A / scale
 
   void release() {
     if (amg)
@@ -116,6 +119,17 @@ void AmgPreconditioner::setup(const Matrix& m) {
   const std::size_t nnz = l.values.extent(0);
   std::vector<HYPRE_BigInt> rows(std::size_t(d.n)), colidx(nnz);
   std::vector<HYPRE_Int> counts(std::size_t(d.n)), diag(std::size_t(d.n)), offd(std::size_t(d.n));
+  // hypre sees A / scale, scale the largest diagonal entry: its set-up compares entries with
+  // absolute thresholds, and the projection's matrix can be ~1e-14 throughout (Example 1 case 2
+  // after 2250 steps: "Error in argument 1" from BoomerAMGSetup; scaled, it sets up). Every
+  // level of a Galerkin hierarchy scales alike, so the V-cycle of A / scale is scale times A's.
+  double largest = 0;
+  for (LocalId r = 0; r < d.n; ++r)
+    for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q)
+      if (HYPRE_BigInt(cv(l.graph.entries(q), 0)) == lower + r)
+        largest = std::max(largest, std::abs(l.values(q)));
+  MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_DOUBLE, MPI_MAX, d.comm);
+  d.scale = largest > 0 ? largest : 1.0;
   std::vector<double> values(nnz);
   for (LocalId r = 0; r < d.n; ++r) {
     rows[std::size_t(r)] = lower + r;
@@ -123,7 +137,7 @@ void AmgPreconditioner::setup(const Matrix& m) {
     for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q) {
       const auto c = HYPRE_BigInt(cv(l.graph.entries(q), 0));
       colidx[q] = c;
-      values[q] = l.values(q);
+      values[q] = l.values(q) / d.scale;
       ++(c >= lower && c <= upper ? diag : offd)[std::size_t(r)];
     }
   }
@@ -170,7 +184,19 @@ void AmgPreconditioner::setup(const Matrix& m) {
   // tests/solvers/test_pressure_solve.cpp), for the same iterations.
   HYPRE_BoomerAMGSetCycleRelaxType(d.amg, 6, 3);
   HYPRE_BoomerAMGSetNumSweeps(d.amg, 1);
-  check(HYPRE_BoomerAMGSetup(d.amg, d.a, d.b, d.x), "BoomerAMGSetup");
+  // hypre's error flag also records conditions its set-up goes on from: an argument error deep
+  // inside it ("Error in argument 1", Example 1 case 2 after 2250 steps) left a complete
+  // hierarchy (5 levels, operator complexity 1.05) with which CG converged as usual. Those are
+  // counted (warnings()); a generic or memory error is a failure. Whether a hierarchy serves is
+  // decided by the solve, which reports non-convergence (exit 3).
+  HYPRE_ClearAllErrors();
+  const HYPRE_Int err = HYPRE_BoomerAMGSetup(d.amg, d.a, d.b, d.x);
+  if (err & (HYPRE_ERROR_GENERIC | HYPRE_ERROR_MEMORY) || levels() < 1)
+    check(err ? err : HYPRE_ERROR_GENERIC, "BoomerAMGSetup");
+  if (err) {
+    HYPRE_ClearAllErrors();
+    ++warnings_;
+  }
 }
 
 void AmgPreconditioner::apply(const MV& x, MV& y, Teuchos::ETransp, double alpha,
@@ -189,8 +215,9 @@ void AmgPreconditioner::apply(const MV& x, MV& y, Teuchos::ETransp, double alpha
       xd[r] = 0.0;
     }
     check(HYPRE_BoomerAMGSolve(d.amg, d.a, d.b, d.x), "BoomerAMGSolve");
+    const double a = alpha / d.scale;
     for (LocalId r = 0; r < d.n; ++r)
-      yv(r, c) = beta == 0.0 ? alpha * xd[r] : beta * yv(r, c) + alpha * xd[r];
+      yv(r, c) = beta == 0.0 ? a * xd[r] : beta * yv(r, c) + a * xd[r];
   }
 }
 

@@ -89,6 +89,50 @@ Teuchos::RCP<CrsMatrix> sparsified(const CrsMatrix& a, double theta) {
   p->fillComplete(a.getDomainMap(), a.getRangeMap());
   return p;
 }
+// Writes A and b as MatrixMarket files (Diagnostics->Write Pressure System), with the rows
+// numbered 0, 1, ... rank by rank in each rank's order (MatrixMarket needs indices below the
+// size; the projection's joint numbering has gaps: crack_offset).
+void write_system(const CrsMatrix& a, const TpetraVector& b, const std::string& prefix,
+                  const std::string& n) {
+  using Map = Tpetra::Map<LocalId, GlobalId>;
+  const auto& rows = a.getRowMap();
+  const std::size_t mine = rows->getNodeNumElements();
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  auto contiguous = Teuchos::rcp(new Map(invalid, mine, 0, rows->getComm()));
+  TpetraVector own(rows), cols(a.getColMap());
+  {
+    auto v = own.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t r = 0; r < mine; ++r)
+      v(r, 0) = double(contiguous->getGlobalElement(LocalId(r)));
+  }
+  cols.doImport(own, Tpetra::Import<LocalId, GlobalId>(rows, a.getColMap()), Tpetra::INSERT);
+  const auto cv = cols.getLocalViewHost(Tpetra::Access::ReadOnly);
+  const auto l = a.getLocalMatrixHost();
+  auto c = Teuchos::rcp(new CrsMatrix(contiguous, a.getNodeMaxNumRowEntries()));
+  std::vector<GlobalId> idx;
+  std::vector<double> val;
+  for (LocalId r = 0; r < LocalId(mine); ++r) {
+    idx.clear();
+    val.clear();
+    for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q) {
+      idx.push_back(GlobalId(cv(l.graph.entries(q), 0)));
+      val.push_back(l.values(q));
+    }
+    c->insertGlobalValues(contiguous->getGlobalElement(r), Teuchos::ArrayView<const GlobalId>(idx),
+                          Teuchos::ArrayView<const double>(val));
+  }
+  c->fillComplete();
+  TpetraVector cb(contiguous);
+  {
+    auto to = cb.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    const auto from = b.getLocalViewHost(Tpetra::Access::ReadOnly);
+    for (std::size_t r = 0; r < mine; ++r)
+      to(r, 0) = from(r, 0);
+  }
+  using Writer = Tpetra::MatrixMarket::Writer<CrsMatrix>;
+  Writer::writeSparseFile(prefix + "pressure_system_" + n + ".mtx", c);
+  Writer::writeDenseFile(prefix + "pressure_rhs_" + n + ".mtx", cb);
+}
 }  // namespace
 
 struct LinearSolve::Impl {
@@ -245,8 +289,8 @@ void LinearSolve::precondition() {
   }
   if (set_.preconditioner == "AMG" && !jacobi_ && !ilu_) {
     impl_->pm = impl_->a;
-    if (set_.drop_tolerance > 0)
-      impl_->pm = sparsified(*impl_->a, set_.drop_tolerance);
+    if (set_.amg_drop_tolerance > 0)
+      impl_->pm = sparsified(*impl_->a, set_.amg_drop_tolerance);
     auto amg = Teuchos::rcp(new AmgPreconditioner(set_));
     std::string what = "a set-up failure on another rank";
     if (!fails_anywhere(
@@ -306,12 +350,8 @@ LinearSolveResult LinearSolve::solve(const TpetraVector& b, TpetraVector& x, dou
     return r;
   }
   scale = std::max(scale, bn);
-  if (++solves_ == set_.write_at) {
-    using Writer = Tpetra::MatrixMarket::Writer<CrsMatrix>;
-    const std::string n = std::to_string(solves_);
-    Writer::writeSparseFile(set_.write_prefix + "pressure_system_" + n + ".mtx", impl_->a);
-    Writer::writeDenseFile(set_.write_prefix + "pressure_rhs_" + n + ".mtx", b);
-  }
+  if (++solves_ == set_.write_at)
+    write_system(*impl_->a, b, set_.write_prefix, std::to_string(solves_));
   if (!(bn > 0)) {
     x.putScalar(0.0);
     r.converged = true;

@@ -89,6 +89,16 @@ struct ProjectionMatrix {
   }
 };
 
+// The entries of this rank in which x and y differ (bit for bit).
+inline std::size_t differing(const TpetraVector& x, const TpetraVector& y) {
+  const auto xv = x.getLocalViewHost(Tpetra::Access::ReadOnly);
+  const auto yv = y.getLocalViewHost(Tpetra::Access::ReadOnly);
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < xv.extent(0); ++i)
+    n += xv(i, 0) != yv(i, 0);
+  return n;
+}
+
 }  // namespace test
 }  // namespace mupm
 

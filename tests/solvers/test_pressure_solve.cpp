@@ -116,12 +116,7 @@ TEST(PressureSolve, AmgHierarchyKeptUntilItServesBadlyAndRenewedLikeARestart) {
   TpetraVector x(m.owned), y(m.owned);
   solve_smooth(solve, m, "renewed", &x);
   solve_smooth(restarted, m, "restarted", &y);
-  const auto xv = x.getLocalViewHost(Tpetra::Access::ReadOnly);
-  const auto yv = y.getLocalViewHost(Tpetra::Access::ReadOnly);
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < xv.extent(0); ++i)
-    differ += xv(i, 0) != yv(i, 0);
-  EXPECT_EQ(differ, 0u) << "renewed AMG and a fresh one";
+  EXPECT_EQ(test::differing(x, y), 0u) << "renewed AMG and a fresh one";
 }
 
 // The V-cycle is a symmetric operator (CG needs it): x^T M^-1 y = y^T M^-1 x for rough x, y, to

@@ -65,10 +65,14 @@ class AmgPreconditioner : public Tpetra::Operator<double, LocalId, GlobalId> {
   // finest's) of the last set-up, for measurement.
   int levels() const;
   double operator_complexity() const;
+  // Set-ups whose hypre error flag held an argument or convergence error, taken as warnings
+  // (setup()).
+  long long warnings() const { return warnings_; }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  long long warnings_ = 0;
   Teuchos::RCP<const map_type> map_;
 };
 

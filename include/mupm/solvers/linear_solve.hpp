@@ -1,14 +1,17 @@
 // A distributed sparse linear solve on Trilinos' stack: a Tpetra CrsMatrix over the points' map
 // (or the fracture network's), Belos' GMRES (or CG for a symmetric positive definite matrix) and
-// an Ifpack2 preconditioner (ILU(k) by default, or Jacobi), built once per matrix and reused for
-// every right-hand side until the matrix changes (set_matrix; refresh when only its values do,
-// which may keep the factors of earlier values for a while: refresh_interval). No rank ever
+// a preconditioner: hypre's algebraic multigrid (AMG, include/mupm/solvers/amg_preconditioner.hpp),
+// Ifpack2's ILU(k) or Jacobi (LinearSolveSettings::preconditioner; the fracture network's own
+// solve takes ILU), built once per matrix and reused for every right-hand side until the matrix
+// changes (set_matrix; refresh when only its values do, which may keep the factors or the
+// hierarchy of earlier values for a while: refresh_interval, refresh_growth). No rank ever
 // holds more than its own rows.
 //
 // Results across rank counts: the Krylov iterates depend on the order of the reductions and on
-// the preconditioner's subdomains (Ifpack2 builds ILU per rank, additive Schwarz without
-// overlap), so the solution agrees across rank counts to the solve's tolerance, not to the bit.
-// The tolerance is on ||b - A x|| relative to the largest ||b|| solved so far (solve()).
+// the preconditioner's subdomains (ILU per rank, additive Schwarz without overlap; AMG's
+// coarsening per rank), so the solution agrees across rank counts to the solve's tolerance, not
+// to the bit. The tolerance is on ||b - A x|| relative to the largest ||b|| solved so far
+// (solve()).
 #ifndef MUPM_SOLVERS_LINEAR_SOLVE_HPP
 #define MUPM_SOLVERS_LINEAR_SOLVE_HPP
 

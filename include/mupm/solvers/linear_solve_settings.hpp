@@ -15,7 +15,7 @@ struct LinearSolveSettings {
   std::string method = "GMRES";
   // "AMG" (hypre BoomerAMG, include/mupm/solvers/amg_preconditioner.hpp) | "ILU" (Ifpack2
   // RILUK) | "Jacobi" | "None"
-  std::string preconditioner = "ILU";
+  std::string preconditioner = "AMG";
   int fill_level = 0;        // ILU(k)
   double tolerance = 1e-11;  // ||b - A x|| / the largest ||b|| so far
   int max_iterations = 1000;
@@ -51,6 +51,11 @@ struct LinearSolveSettings {
   double amg_strong_threshold = 0.25;
   int amg_interpolation_entries = 4;
   int amg_aggressive_levels = 0;
+  // AMG: > 0, the hierarchy is of A less its entries below this (as drop_tolerance for ILU). Each
+  // dropped |a_ij| on the diagonal adds |a_ij| (e_i + e_j)(e_i + e_j)^T for a negative a_ij: a
+  // mass on the smoothest modes, which AMG's coarse levels then see instead of A's, so the
+  // iterations grow under refinement (measured: perf/README.md). 0: the whole matrix.
+  double amg_drop_tolerance = 0;
   // AMG: after a set-up failure, ILU for this matrix's values instead of stopping the run.
   bool amg_fallback = false;
   // > 0: the write_at-th solve writes its matrix and right-hand side (MatrixMarket, gathered on

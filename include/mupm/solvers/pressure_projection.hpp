@@ -160,11 +160,13 @@
 // the graphs hold every bond of the lists (a broken one at zero) and change only with the
 // network's points or B_f's columns; B~ = diag(S_r) B_0 and the transposes of B_0 and of the
 // flow's gradient are kept while the bonds are, so a change of S_r, k_r or the densities needs
-// no transpose. The preconditioner's factors then follow LinearSolve::refresh (kept up to
-// Preconditioner Refresh Interval steps, renewed after each checkpoint). The solve is CG where A
-// is symmetric (no image points; krylov below), GMRES otherwise, each with ILU(k) of A less its
-// small (far) entries: Pressure Solve's Drop Tolerance
-// (include/mupm/solvers/linear_solve_settings.hpp).
+// no transpose. The preconditioner then follows LinearSolve::refresh (kept up to Preconditioner
+// Refresh Interval steps or until a solve takes Refresh Iteration Growth times the iterations of
+// the first after its set-up, renewed after each checkpoint). The solve is CG where A is
+// symmetric (no image points; krylov below), GMRES otherwise, each preconditioned by one V-cycle
+// of hypre's algebraic multigrid of A (include/mupm/solvers/amg_preconditioner.hpp; its
+// iterations stay bounded as the body is refined), or by ILU(k) of A less its small (far)
+// entries (Pressure Solve -> Preconditioner, include/mupm/solvers/linear_solve_settings.hpp).
 #ifndef MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 #define MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
 

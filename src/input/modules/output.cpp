@@ -55,7 +55,7 @@ void declare_diagnostics(ParameterList& g) {
   g.set("Write Pressure System", 0,
         "N > 0: the semi-implicit pressure solve's N-th system of the run (matrix, right-hand "
         "side) is written to Output->Folder as pressure_system_N.mtx and pressure_rhs_N.mtx "
-        "(MatrixMarket, rows in global-id order, gathered on rank 0), for studies of the solve "
+        "(MatrixMarket, rows numbered rank by rank, gathered on rank 0), for studies of the solve "
         "outside mupm (perf/bench_pressure_solve). 0: never.",
         at_least(0));
 }

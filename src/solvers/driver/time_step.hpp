@@ -156,8 +156,9 @@ double choose_time_step(const RunSettings& run, Assembly<Dim>& ph, bool restarte
       out << "(" << ls.fill_level << ")";
     if (ls.preconditioner == "AMG")
       out << " (hypre BoomerAMG, strong threshold " << ls.amg_strong_threshold << ")";
+    const double drop = ls.preconditioner == "AMG" ? ls.amg_drop_tolerance : ls.drop_tolerance;
     if (ls.preconditioner == "ILU" || ls.preconditioner == "AMG")
-      out << " of the matrix less its entries below " << ls.drop_tolerance
+      out << " of the matrix less its entries below " << drop
           << " of the diagonals' geometric mean, kept up to " << ls.refresh_interval
           << " steps or until a solve takes " << ls.refresh_growth
           << " times the iterations of the first after it";
