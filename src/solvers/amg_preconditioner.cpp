@@ -119,10 +119,11 @@ void AmgPreconditioner::setup(const Matrix& m) {
   const std::size_t nnz = l.values.extent(0);
   std::vector<HYPRE_BigInt> rows(std::size_t(d.n)), colidx(nnz);
   std::vector<HYPRE_Int> counts(std::size_t(d.n)), diag(std::size_t(d.n)), offd(std::size_t(d.n));
-  // hypre sees A / scale, scale the largest diagonal entry: its set-up compares entries with
-  // absolute thresholds, and the projection's matrix can be ~1e-14 throughout (Example 1 case 2
-  // after 2250 steps: "Error in argument 1" from BoomerAMGSetup; scaled, it sets up). Every
-  // level of a Galerkin hierarchy scales alike, so the V-cycle of A / scale is scale times A's.
+  // hypre sees A / scale, scale the largest diagonal entry, a precaution: the projection's
+  // matrix can be ~1e-14 throughout (Example 1 case 2), and hypre's set-up and smoothers compare
+  // entries with fixed thresholds in places. Every level of a Galerkin hierarchy scales alike,
+  // so the V-cycle of A / scale is scale times A's. (It did not remove the argument-error flag
+  // that matrix raises: see the set-up's call below.)
   double largest = 0;
   for (LocalId r = 0; r < d.n; ++r)
     for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q)

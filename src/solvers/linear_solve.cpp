@@ -233,7 +233,7 @@ void LinearSolve::refresh() {
   // Kept factors: the same decision on every rank (the calls and renewals are collective, the
   // iteration counts global). Stale: the last solve took more than refresh_growth times the
   // first after the set-up.
-  const bool stale = set_.refresh_growth > 0 && base_iterations_ > 0 &&
+  const bool stale = set_.refresh_growth > 1 && base_iterations_ > 0 &&
                      last_iterations_ > set_.refresh_growth * base_iterations_;
   if (!renew_ && !stale && ++kept_ < set_.refresh_interval)
     return;

@@ -52,7 +52,8 @@ class AmgPreconditioner : public Tpetra::Operator<double, LocalId, GlobalId> {
 
   // Builds the hierarchy of `a` (square, rows over its row map = domain = range map): copies
   // its rows into hypre and runs BoomerAMG's set-up. Collective; throws std::runtime_error on
-  // every rank where hypre reports an error (the caller decides together).
+  // every rank where hypre reports a generic or memory error or builds no level (the caller
+  // decides together); hypre's argument and convergence flags are counted (warnings()).
   void setup(const Matrix& a);
   // Y = beta Y + alpha M^-1 X, M^-1 one V-cycle of the hierarchy from a zero guess.
   void apply(const MV& x, MV& y, Teuchos::ETransp mode = Teuchos::NO_TRANS, double alpha = 1.0,

@@ -28,7 +28,7 @@ struct LinearSolveSettings {
   int refresh_interval = 1;
   // > 1: refresh() also computes the preconditioner again when the last solve took more than
   // this many times the iterations of the first solve after its set-up (a kept preconditioner
-  // gone stale: the values drifted). 0: no such rule.
+  // gone stale: the values drifted). <= 1: no such rule.
   double refresh_growth = 0;
   // CG only, > 0: Belos' recycling CG (RCG, Parks et al. 2006) with a recycle space of this many
   // vectors, approximate eigenvectors of the preconditioned matrix's smallest eigenvalues

@@ -93,7 +93,7 @@ void declare_solver(ParameterList& s) {
            rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1.0)));
     ps.set("AMG Fallback", false,
            "AMG: where BoomerAMG's set-up fails, continue with ILU for that matrix's values "
-           "(counted in the log) instead of stopping the run (exit 3).");
+           "instead of stopping the run (exit 3).");
     ps.set("ILU Fill Level", 0, "Level of fill k of ILU(k).", at_least(0));
     ps.set("Drop Tolerance", 0.02,
            "ILU: the factors are of the matrix without its entries |a_ij| < "
@@ -116,7 +116,7 @@ void declare_solver(ParameterList& s) {
            "When the preconditioner is kept from earlier values (Preconditioner Refresh "
            "Interval), it is computed again at the next change once a solve takes more than "
            "this many times the iterations of the first solve after its set-up (values "
-           "drifted). 0: only the interval decides.",
+           "drifted). At most 1 (0 for instance): only the interval decides.",
            rcp(new Teuchos::EnhancedNumberValidator<double>(0.0, 1e6)));
     ps.set("Tolerance", 1e-11,
            "Residual ||b - A x|| at which the solve stops, relative to the largest right-hand "
