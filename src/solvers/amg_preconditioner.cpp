@@ -6,8 +6,6 @@
 #include <_hypre_parcsr_ls.h>  // the hierarchy's levels and sizes (levels, operator_complexity)
 
 #include <Teuchos_DefaultMpiComm.hpp>
-#include <Tpetra_Import.hpp>
-#include <Tpetra_Vector.hpp>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -15,6 +13,7 @@
 #include <vector>
 
 #include "mupm/core/timers.hpp"
+#include "mupm/solvers/linear_solve.hpp"
 
 namespace mupm {
 
@@ -97,25 +96,11 @@ void AmgPreconditioner::setup(const Matrix& m) {
   d.comm = raw_comm(*map_->getComm());
   const auto l = m.getLocalMatrixHost();
   d.n = LocalId(l.numRows());
-  // hypre's rows: this rank's [lower, upper], in its Tpetra rows' order.
-  long long mine = d.n, lower = 0;
-  MPI_Exscan(&mine, &lower, 1, MPI_LONG_LONG, MPI_SUM, d.comm);
-  int rank = 0;
-  MPI_Comm_rank(d.comm, &rank);
-  if (rank == 0)
-    lower = 0;
-  const HYPRE_BigInt upper = lower + d.n - 1;
-  // Each column's hypre index: the rows' indices imported to the column map (exact as
-  // doubles below 2^53).
-  using Vec = Tpetra::Vector<double, LocalId, GlobalId>;
-  Vec own(map_), cols(m.getColMap());
-  {
-    auto v = own.getLocalViewHost(Tpetra::Access::OverwriteAll);
-    for (LocalId r = 0; r < d.n; ++r)
-      v(r, 0) = double(lower + r);
-  }
-  cols.doImport(own, Tpetra::Import<LocalId, GlobalId>(map_, m.getColMap()), Tpetra::INSERT);
-  const auto cv = cols.getLocalViewHost(Tpetra::Access::ReadOnly);
+  // hypre's rows: this rank's [lower, upper], in its Tpetra rows' order, and each column's
+  // hypre index.
+  const auto numbering = contiguous_numbering(m);
+  const HYPRE_BigInt lower = numbering.first, upper = lower + d.n - 1;
+  const auto& cv = numbering.column;
   const std::size_t nnz = l.values.extent(0);
   std::vector<HYPRE_BigInt> rows(std::size_t(d.n)), colidx(nnz);
   std::vector<HYPRE_Int> counts(std::size_t(d.n)), diag(std::size_t(d.n)), offd(std::size_t(d.n));
@@ -127,7 +112,7 @@ void AmgPreconditioner::setup(const Matrix& m) {
   double largest = 0;
   for (LocalId r = 0; r < d.n; ++r)
     for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q)
-      if (HYPRE_BigInt(cv(l.graph.entries(q), 0)) == lower + r)
+      if (cv[std::size_t(l.graph.entries(q))] == lower + r)
         largest = std::max(largest, std::abs(l.values(q)));
   MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_DOUBLE, MPI_MAX, d.comm);
   d.scale = largest > 0 ? largest : 1.0;
@@ -136,7 +121,7 @@ void AmgPreconditioner::setup(const Matrix& m) {
     rows[std::size_t(r)] = lower + r;
     counts[std::size_t(r)] = HYPRE_Int(l.graph.row_map(r + 1) - l.graph.row_map(r));
     for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q) {
-      const auto c = HYPRE_BigInt(cv(l.graph.entries(q), 0));
+      const HYPRE_BigInt c = cv[std::size_t(l.graph.entries(q))];
       colidx[q] = c;
       values[q] = l.values(q) / d.scale;
       ++(c >= lower && c <= upper ? diag : offd)[std::size_t(r)];

@@ -90,23 +90,14 @@ Teuchos::RCP<CrsMatrix> sparsified(const CrsMatrix& a, double theta) {
   return p;
 }
 // Writes A and b as MatrixMarket files (Diagnostics->Write Pressure System), with the rows
-// numbered 0, 1, ... rank by rank in each rank's order (MatrixMarket needs indices below the
-// size; the projection's joint numbering has gaps: crack_offset).
+// numbered contiguously (contiguous_numbering: MatrixMarket needs indices below the size).
 void write_system(const CrsMatrix& a, const TpetraVector& b, const std::string& prefix,
                   const std::string& n) {
   using Map = Tpetra::Map<LocalId, GlobalId>;
-  const auto& rows = a.getRowMap();
-  const std::size_t mine = rows->getNodeNumElements();
+  const std::size_t mine = a.getRowMap()->getNodeNumElements();
   const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
-  auto contiguous = Teuchos::rcp(new Map(invalid, mine, 0, rows->getComm()));
-  TpetraVector own(rows), cols(a.getColMap());
-  {
-    auto v = own.getLocalViewHost(Tpetra::Access::OverwriteAll);
-    for (std::size_t r = 0; r < mine; ++r)
-      v(r, 0) = double(contiguous->getGlobalElement(LocalId(r)));
-  }
-  cols.doImport(own, Tpetra::Import<LocalId, GlobalId>(rows, a.getColMap()), Tpetra::INSERT);
-  const auto cv = cols.getLocalViewHost(Tpetra::Access::ReadOnly);
+  auto contiguous = Teuchos::rcp(new Map(invalid, mine, 0, a.getRowMap()->getComm()));
+  const auto numbering = contiguous_numbering(a);
   const auto l = a.getLocalMatrixHost();
   auto c = Teuchos::rcp(new CrsMatrix(contiguous, a.getNodeMaxNumRowEntries()));
   std::vector<GlobalId> idx;
@@ -115,7 +106,7 @@ void write_system(const CrsMatrix& a, const TpetraVector& b, const std::string& 
     idx.clear();
     val.clear();
     for (auto q = l.graph.row_map(r); q < l.graph.row_map(r + 1); ++q) {
-      idx.push_back(GlobalId(cv(l.graph.entries(q), 0)));
+      idx.push_back(numbering.column[std::size_t(l.graph.entries(q))]);
       val.push_back(l.values(q));
     }
     c->insertGlobalValues(contiguous->getGlobalElement(r), Teuchos::ArrayView<const GlobalId>(idx),
@@ -134,6 +125,29 @@ void write_system(const CrsMatrix& a, const TpetraVector& b, const std::string& 
   Writer::writeDenseFile(prefix + "pressure_rhs_" + n + ".mtx", cb);
 }
 }  // namespace
+
+ContiguousNumbering contiguous_numbering(const CrsMatrix& a) {
+  const auto& rows = a.getRowMap();
+  const LocalId n = LocalId(rows->getNodeNumElements());
+  ContiguousNumbering out;
+  long long mine = n, first = 0;
+  const auto comm = rows->getComm();
+  Teuchos::scan(*comm, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(first));
+  out.first = first - mine;  // the inclusive scan less this rank's own
+  // The numbers travel as doubles (exact below 2^53).
+  TpetraVector own(rows), cols(a.getColMap());
+  {
+    auto v = own.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (LocalId r = 0; r < n; ++r)
+      v(r, 0) = double(out.first + r);
+  }
+  cols.doImport(own, Tpetra::Import<LocalId, GlobalId>(rows, a.getColMap()), Tpetra::INSERT);
+  const auto cv = cols.getLocalViewHost(Tpetra::Access::ReadOnly);
+  out.column.resize(cv.extent(0));
+  for (std::size_t c = 0; c < out.column.size(); ++c)
+    out.column[c] = GlobalId(cv(c, 0));
+  return out;
+}
 
 struct LinearSolve::Impl {
   Teuchos::RCP<Teuchos::ParameterList> params;

@@ -19,6 +19,7 @@
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_Vector.hpp>
 #include <string>
+#include <vector>
 
 #include "mupm/core/types.hpp"
 #include "mupm/solvers/linear_solve_settings.hpp"
@@ -45,11 +46,18 @@ struct LinearSolveResult {
 
 class AmgPreconditioner;
 
+// The rows of `a` numbered 0, 1, ... rank by rank in each rank's row order (this rank's first is
+// `first`), and the number of each of its local columns in that numbering (an import of the
+// rows' numbers to the column map). Collective. For libraries and files that need contiguous
+// indices (hypre, MatrixMarket); the projection's joint numbering has gaps (crack_offset).
+struct ContiguousNumbering {
+  GlobalId first = 0;
+  std::vector<GlobalId> column;  // [the column map's local index]
+};
+ContiguousNumbering contiguous_numbering(const CrsMatrix& a);
+
 class LinearSolve {
  public:
-  // Belos' RCG: iterations a cycle, at whose end the recycle space is gathered; a space of at
-  // most kRcgCycle - 1 vectors.
-  static constexpr int kRcgCycle = 25;
   explicit LinearSolve(const LinearSolveSettings& settings);
   ~LinearSolve();
   LinearSolve(const LinearSolve&) = delete;

@@ -7,6 +7,10 @@
 
 namespace mupm {
 
+// Belos' RCG: iterations a cycle, at whose end the recycle space is gathered; a space of at most
+// kRcgCycle - 1 vectors (LinearSolveSettings::recycle).
+inline constexpr int kRcgCycle = 25;
+
 struct LinearSolveSettings {
   // "GMRES" | "CG": CG needs a symmetric positive definite matrix and preconditioner (ILU(k) of
   // a symmetric matrix is L D L^T up to round-off); it keeps no basis, so an iteration costs a

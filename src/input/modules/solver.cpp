@@ -1,6 +1,7 @@
 #include "../input_module.hpp"
 
 #include "mupm/input/options.hpp"
+#include "mupm/solvers/linear_solve_settings.hpp"
 
 namespace mupm {
 
@@ -133,9 +134,10 @@ void declare_solver(ParameterList& s) {
            "preconditioner applies a step become 28, the solve 1.3 times faster with 10, "
            "perf/README.md). The "
            "space is dropped at each checkpoint, so a restart continues bit for bit. Not "
-           "used with GMRES (mirrored pressure layers). 0: CG. At most 24 (RCG gathers the "
-           "space every 25 iterations).",
-           rcp(new Teuchos::EnhancedNumberValidator<int>(0, 24)));
+           "used with GMRES (mirrored pressure layers). 0: CG. At most " +
+               std::to_string(kRcgCycle - 1) + " (RCG gathers the space every " +
+               std::to_string(kRcgCycle) + " iterations).",
+           rcp(new Teuchos::EnhancedNumberValidator<int>(0, kRcgCycle - 1)));
   }
   s.set("Time Step", 1e-6, "Time step dt [s] (> 0).", positive());
   s.set("Automatic Time Step", false,
