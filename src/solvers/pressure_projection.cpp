@@ -13,13 +13,20 @@ auto PressureProjection<Dim>::step(double dt, const FluidParams& prm, const Flui
   const bool refilled = needs_assembly(dt, st, sk, crack);
   if (refilled)
     assemble(dt, prm, st, sk, crack);
-  Teuchos::RCP<CrsMatrix> network;
   if (any_crack_) {  // the network's rows change every step (apertures): new values
-    network = network_rows(crack);
-    auto ns = Teuchos::rcp(new CrsMatrix(joint_, 0));
-    Tpetra::MatrixMatrix::Multiply(*network, false, *s_h_.matrix(), false, *ns);
-    ns->leftScale(*keep_);
-    compose(*ns);
+    bool graph = network_values(crack);
+    // ns = R N S_H: without images S_H = diag(keep) (assemble), so ns is N scaled by keep on
+    // both sides (exact: keep is 0 or 1), on N's graph; with images a product on a kept graph.
+    if (!images_any_) {
+      copy_values(ns_, *network_, graph);
+      ns_->rightScale(*keep_);
+    } else {
+      graph = graph || ns_graph_;
+      ns_product_.update(graph, *network_, false, *s_h_.matrix(), false);
+      ns_ = ns_product_.matrix();
+    }
+    ns_->leftScale(*keep_);
+    compose(*ns_, graph);
   } else if (system_ != composed_.matrix()) {
     system_ = composed_.matrix();
     solver_.set_matrix(system_);
@@ -31,7 +38,7 @@ auto PressureProjection<Dim>::step(double dt, const FluidParams& prm, const Flui
   const auto& owned = disc_.dist.owned_map();
   TpetraVector &du = work(kDu, dofs_), &bp = work(kBp, owned), &b = work(kB, joint_),
                &c = work(kC, joint_), &ac = work(kAc, joint_), &x = work(kX, joint_),
-               &y = work(kY, joint_);
+               &y = work(kY, joint_), &e = work(kE, joint_);
   {
     auto v = du.getLocalViewHost(Tpetra::Access::OverwriteAll);
     for (std::size_t i = 0; i < n; ++i) {
@@ -43,32 +50,38 @@ auto PressureProjection<Dim>::step(double dt, const FluidParams& prm, const Flui
   }
   coupling_.matrix()->apply(du, bp);  // B_0 du, then diag(S_r)
   bp.elementWiseMultiply(1.0, *saturation_, bp, 0.0);
+  // Whether c (the held increments) and e (the unfelt p_f^n) have a nonzero anywhere: where
+  // not, their products below are zero and skipped (most steps: held pressures that stay, no
+  // point joining the network).
+  int nonzero[2] = {0, 0};
   {
     auto cv = c.getLocalViewHost(Tpetra::Access::OverwriteAll);
     for (std::size_t i = 0; i < n; ++i)
-      cv(i, 0) = roles_[i] == PressureRole::Free ? 0.0 : target(i) - p.p(i);
+      nonzero[0] |= (cv(i, 0) = roles_[i] == PressureRole::Free ? 0.0 : target(i) - p.p(i)) != 0;
     for (std::size_t k = 0; k < m; ++k)
-      cv(n + k, 0) = crack.held[k] ? crack.start[k] : 0.0;
+      nonzero[0] |= (cv(n + k, 0) = crack.held[k] ? crack.start[k] : 0.0) != 0;
+    auto ev = e.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < n; ++i)
+      ev(i, 0) = 0.0;
+    for (std::size_t k = 0; k < m; ++k)
+      nonzero[1] |= (ev(n + k, 0) = crack.unfelt[k]) != 0;
   }
-  static_.matrix()->apply(c, ac);      // A c = (static part + the network's rows) c
-  TpetraVector& e = work(kE, joint_);  // the unfelt p_f^n (CrackBlock): the correction applies it
-  if (any_crack_) {
-    network->apply(c, ac, Teuchos::NO_TRANS, 1.0, 1.0);
-    {
-      auto ev = e.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (std::size_t i = 0; i < n; ++i)
-        ev(i, 0) = 0.0;
-      for (std::size_t k = 0; k < m; ++k)
-        ev(n + k, 0) = crack.unfelt[k];
-    }
-    // ... and the volume change it gives the skeleton within the step: dt^2 B M^-1 B^T e.
+  MPI_Allreduce(MPI_IN_PLACE, nonzero, 2, MPI_INT, MPI_MAX, comm_);
+  if (nonzero[0]) {
+    static_.matrix()->apply(c, ac);  // A c = (static part + the network's rows) c
+    if (any_crack_)
+      network_->apply(c, ac, Teuchos::NO_TRANS, 1.0, 1.0);
+  } else {
+    ac.putScalar(0.0);
+  }
+  if (nonzero[1]) {
+    // ... and the volume change the unfelt p_f^n gives the skeleton within the step (the
+    // correction applies it): dt^2 B M^-1 B^T e.
     TpetraVector &fe = work(kFe, dofs_), &be = work(kBe, joint_);
     coupling_s_->apply(e, fe, Teuchos::TRANS);
     fe.elementWiseMultiply(1.0, *inverse_mass_, fe, 0.0);
     coupling_s_->apply(fe, be);
     ac.update(dt * dt, be, 1.0);
-  } else {
-    e.putScalar(0.0);
   }
   {
     auto bv = b.getLocalViewHost(Tpetra::Access::OverwriteAll);
@@ -199,53 +212,40 @@ bool PressureProjection<Dim>::any_images(const std::vector<PressureRole>& roles,
 }
 
 template <int Dim>
-void PressureProjection<Dim>::compose(const CrsMatrix& ns) {
+void PressureProjection<Dim>::compose(const CrsMatrix& ns, bool graph) {
   ScopedRegion region("mupm::Pressure::compose");
   const auto nl = ns.getLocalMatrixHost();
-  const auto& ncols = *ns.getColMap();
-  std::vector<GlobalId> pattern;  // (row, column) gids of ns's entries, in its storage order
-  pattern.reserve(2 * nl.values.extent(0));
-  for (LocalId r = 0; r < LocalId(nl.numRows()); ++r)
-    for (auto q = nl.graph.row_map(r); q < nl.graph.row_map(r + 1); ++q) {
-      pattern.push_back(joint_->getGlobalElement(r));
-      pattern.push_back(ncols.getGlobalElement(nl.graph.entries(q)));
-    }
   const auto& composed = composed_.matrix();
-  int rebuild = system_.is_null() || system_ == composed || pattern != pattern_ ? 1 : 0;
-  MPI_Allreduce(MPI_IN_PLACE, &rebuild, 1, MPI_INT, MPI_MAX, comm_);
+  const bool rebuild = graph || system_.is_null() || system_ == composed;  // the same everywhere
   if (rebuild) {
     system_ = Tpetra::MatrixMatrix::add(1.0, false, *composed, 1.0, false, ns);
     if (!system_->getRowMap()->isSameAs(*joint_) || !composed->getRowMap()->isSameAs(*joint_))
       throw std::logic_error("PressureProjection::compose: the rows are not the joint map's");
-    const auto sl = system_->getLocalMatrixHost();
-    const auto& scols = *system_->getColMap();
-    // The position in system_ of row r's entry at global column g.
-    auto at = [&](LocalId r, GlobalId g) {
-      for (auto q = sl.graph.row_map(r); q < sl.graph.row_map(r + 1); ++q)
-        if (scols.getGlobalElement(sl.graph.entries(q)) == g)
-          return std::size_t(q);
-      throw std::logic_error("PressureProjection::compose: an entry is not in the sum's graph");
-    };
-    const auto cl = composed->getLocalMatrixHost();
-    const auto& ccols = *composed->getColMap();
-    base_.resize(cl.values.extent(0));
-    for (LocalId r = 0; r < LocalId(cl.numRows()); ++r)
-      for (auto q = cl.graph.row_map(r); q < cl.graph.row_map(r + 1); ++q)
-        base_[std::size_t(q)] = at(r, ccols.getGlobalElement(cl.graph.entries(q)));
-    where_.resize(nl.values.extent(0));
-    for (std::size_t q = 0; q < where_.size(); ++q)
-      where_[q] = at(joint_->getLocalElement(pattern[2 * q]), pattern[2 * q + 1]);
-    pattern_ = std::move(pattern);
+    base_ = detail::positions_of(*system_, *composed);
+    where_ = detail::positions_of(*system_, ns);
+    ns_graph_ = false;
   }
-  {
-    const auto v = system_->getLocalValuesView();
-    const auto cv = composed->getLocalValuesView();
+  const auto v = system_->getLocalValuesView();
+  const auto cv = composed->getLocalValuesView();
+  if (rebuild || composed_changed_) {  // every value: composed_'s, then ns's added
     for (std::size_t q = 0; q < v.extent(0); ++q)
       v(q) = 0.0;
     for (std::size_t q = 0; q < base_.size(); ++q)
       v(base_[q]) = cv(q);
     for (std::size_t q = 0; q < where_.size(); ++q)
       v(where_[q]) += nl.values(q);
+    if (rebuild) {  // composed_'s entry (or none: -1) at each of ns's positions
+      std::vector<std::ptrdiff_t> of(v.extent(0), -1);
+      for (std::size_t q = 0; q < base_.size(); ++q)
+        of[base_[q]] = std::ptrdiff_t(q);
+      under_.resize(where_.size());
+      for (std::size_t q = 0; q < where_.size(); ++q)
+        under_[q] = of[where_[q]];
+    }
+    composed_changed_ = false;
+  } else {  // composed_ as before: ns's positions alone, to the same sums
+    for (std::size_t q = 0; q < where_.size(); ++q)
+      v(where_[q]) = (under_[q] < 0 ? 0.0 : cv(std::size_t(under_[q]))) + nl.values(q);
   }
   if (rebuild)
     solver_.set_matrix(system_);
@@ -254,36 +254,71 @@ void PressureProjection<Dim>::compose(const CrsMatrix& ns) {
 }
 
 template <int Dim>
-Teuchos::RCP<CrsMatrix> PressureProjection<Dim>::network_rows(const CrackBlock& crack) const {
+bool PressureProjection<Dim>::network_values(const CrackBlock& crack) {
   const auto& p = disc_.points;
-  std::size_t longest = 2;
-  for (const auto& f : crack.flow)
-    longest = std::max(longest, f.size() + 2);
-  auto a = Teuchos::rcp(new CrsMatrix(joint_, longest));
-  std::vector<GlobalId> cols;
-  std::vector<double> vals;
+  // The entries in a fixed order: per network point, its pore-pressure row (exchange), then its
+  // fracture-pressure row (exchange, flows, diagonal).
+  std::vector<GlobalId> pattern;  // (row, column) gids
+  std::vector<double> values;
   for (std::size_t k = 0; k < crack.point.size(); ++k) {
     const GlobalId g = p.gid(crack.point[k]), gf = crack.offset + g;
     const double ex = crack.exchange[k];
-    cols = {g, gf};
-    vals = {ex, -ex};
-    a->insertGlobalValues(g, Teuchos::ArrayView<const GlobalId>(cols),
-                          Teuchos::ArrayView<const double>(vals));
+    pattern.insert(pattern.end(), {g, g, g, gf, gf, g});
+    values.insert(values.end(), {ex, -ex, -ex});
     double diag = crack.storage[k] + ex;
-    cols = {g};
-    vals = {-ex};
     for (const auto& e : crack.flow[k]) {
-      cols.push_back(e.first);
-      vals.push_back(-e.second);
+      pattern.insert(pattern.end(), {gf, e.first});
+      values.push_back(-e.second);
       diag += e.second;
     }
-    cols.push_back(gf);
-    vals.push_back(diag);
-    a->insertGlobalValues(gf, Teuchos::ArrayView<const GlobalId>(cols),
-                          Teuchos::ArrayView<const double>(vals));
+    pattern.insert(pattern.end(), {gf, gf});
+    values.push_back(diag);
   }
-  a->fillComplete(joint_, joint_);
-  return a;
+  int rebuild = network_.is_null() || network_->getRowMap().get() != joint_.get() ||
+                        pattern != network_pattern_
+                    ? 1
+                    : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &rebuild, 1, MPI_INT, MPI_MAX, comm_);
+  if (rebuild) {
+    // Each row's entries, listed in the order above.
+    const LocalId rows = LocalId(joint_->getNodeNumElements());
+    std::vector<std::vector<std::size_t>> of_row{std::size_t(rows)};
+    for (std::size_t q = 0; q < values.size(); ++q)
+      of_row[std::size_t(joint_->getLocalElement(pattern[2 * q]))].push_back(q);
+    std::size_t longest = 1;
+    for (const auto& r : of_row)
+      longest = std::max(longest, r.size());
+    network_ = Teuchos::rcp(new CrsMatrix(joint_, longest));
+    std::vector<GlobalId> cols;
+    const std::vector<double> zeros(longest, 0.0);
+    for (LocalId r = 0; r < rows; ++r) {
+      const auto& qs = of_row[std::size_t(r)];
+      if (qs.empty())
+        continue;
+      cols.clear();
+      for (const std::size_t q : qs)
+        cols.push_back(pattern[2 * q + 1]);
+      network_->insertGlobalValues(joint_->getGlobalElement(r),
+                                   Teuchos::ArrayView<const GlobalId>(cols),
+                                   Teuchos::ArrayView<const double>(zeros.data(), cols.size()));
+    }
+    network_->fillComplete(joint_, joint_);
+    std::vector<std::size_t> order;
+    const auto listed = detail::positions_in(*network_, [&](LocalId r, auto&& add) {
+      for (const std::size_t q : of_row[std::size_t(r)]) {
+        order.push_back(q);
+        add(pattern[2 * q + 1]);
+      }
+    });
+    network_at_.assign(values.size(), 0);
+    for (std::size_t k = 0; k < listed.size(); ++k)
+      network_at_[order[k]] = listed[k];
+    network_pattern_ = std::move(pattern);
+  }
+  const auto v = network_->getLocalValuesView();
+  for (std::size_t q = 0; q < values.size(); ++q)
+    v(network_at_[q]) = values[q];
+  return rebuild != 0;
 }
 
 template <int Dim>
@@ -350,7 +385,7 @@ void PressureProjection<Dim>::assemble(double dt, const FluidParams& prm, const 
   copy_values(coupling_s_, *joint_coupling_.matrix(), build);
   coupling_s_->leftScale(*sigma_);
   if (geometry_)
-    coupling_t_ = transpose(joint_coupling_.matrix());  // [B_0; B_f]^T
+    coupling_t_.update(build, joint_coupling_.matrix());  // [B_0; B_f]^T
   TpetraVector storage(joint_);
   {
     auto mv = inverse_mass_->getLocalViewHost(Tpetra::Access::OverwriteAll);
@@ -371,7 +406,7 @@ void PressureProjection<Dim>::assemble(double dt, const FluidParams& prm, const 
   copy_values(scaled_coupling_, *coupling_s_, build);
   scaled_coupling_->rightScale(*inverse_mass_);
   const auto& flow = *joint_flow_.matrix();
-  projection_.update(build, *scaled_coupling_, false, *coupling_t_, false);
+  projection_.update(build, *scaled_coupling_, false, *coupling_t_.matrix(), false);
   projection_.matrix()->rightScale(*sigma_);
   storage_.update(build, storage);
   rest_.update(build, dt * dt, *projection_.matrix(), 1.0, *storage_.matrix());
@@ -452,8 +487,11 @@ void PressureProjection<Dim>::assemble(double dt, const FluidParams& prm, const 
   ras->leftScale(*keep_);
   other_.update(build, other);
   composed_.update(build, 1.0, *ras, 1.0, *other_.matrix());
-  if (build)
+  composed_changed_ = true;
+  if (build) {
     system_ = Teuchos::null;
+    ns_graph_ = true;  // S_H's graph is new
+  }
   dt_ = dt;
   stale_ = false;
   ++assemblies_;

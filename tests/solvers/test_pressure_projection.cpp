@@ -145,8 +145,9 @@ bool same_entries(const CrsMatrix& a, const CrsMatrix& b) {
 // The kept graphs (include/mupm/solvers/kept_matrix.hpp): the flow operator and the coupling
 // built on an intact, nearly saturated body, then refilled after bonds break (every bond across
 // x = x0, at both ends) and S_r, k_r and alpha change, equal a fresh build on the new state to
-// the bit (what a restart builds), and the refilled flow operator is the fluid's divergence over
-// the intact bonds, as the fresh one on an intact body is (FlowOperatorIsTheFluidsDivergence).
+// the bit (what a restart builds), B_0^T kept (KeptTranspose) too, and the refilled flow operator
+// is the fluid's divergence over the intact bonds, as the fresh one on an intact body is
+// (FlowOperatorIsTheFluidsDivergence).
 TEST(PressureProjection, KeptGraphsRefilledAfterBreakageEqualAFreshBuild) {
   auto disc = discretize(test::world(), test::box<2>({12, 9}, 3.015));
   auto& p = disc.points;
@@ -163,6 +164,9 @@ TEST(PressureProjection, KeptGraphsRefilledAfterBreakageEqualAFreshBuild) {
   h.build(disc, fp, st.alpha);
   VolumeCoupling<2> b;
   b.build(disc, 0.8);
+  KeptTranspose bt;  // B_0^T: its rows are the dofs, those of ghost columns on another rank
+  bt.build(b.matrix());
+  const auto b_intact = Teuchos::rcp(new CrsMatrix(*b.matrix(), Teuchos::Copy));
   // Break every bond across x0 (a geometric rule: both ends on every rank agree).
   const double x0 = disc.grid.origin[0] + 5.5 * disc.grid.dx;
   long long broken = 0;
@@ -192,6 +196,10 @@ TEST(PressureProjection, KeptGraphsRefilledAfterBreakageEqualAFreshBuild) {
   b_fresh.build(disc, 0.8);
   EXPECT_TRUE(same_entries(*h.matrix(), *h_fresh.matrix()));
   EXPECT_TRUE(same_entries(*b.matrix(), *b_fresh.matrix()));
+  bt.fill(*b.matrix());  // the kept transpose: Tpetra's transposer's of the new values
+  EXPECT_TRUE(same_entries(*bt.matrix(), *transpose(b_fresh.matrix())));
+  EXPECT_FALSE(same_entries(*bt.matrix(), *transpose(b_intact)))
+      << "the refill changed B_0^T's values";
   // A refill that leaves the bonds (geometry = false: the kept transpose of the gradient).
   h.fill(disc, fp, st.alpha, false);
   EXPECT_TRUE(same_entries(*h.matrix(), *h_fresh.matrix()));

@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "mupm/mesh/distribution.hpp"
 #include "mupm/solvers/linear_solve.hpp"
 
 namespace mupm {
@@ -289,6 +290,26 @@ inline Teuchos::RCP<CrsMatrix> transpose(const Teuchos::RCP<const CrsMatrix>& a)
   Tpetra::RowMatrixTransposer<double, LocalId, GlobalId> t(a);
   return t.createTranspose();
 }
+
+// a^T on a graph kept while a's is. Each of a^T's entries is one of a's, moved to the rank that
+// owns its column: build() transposes (Tpetra's transposer) a copy of a whose values are the
+// global numbers of its entries, which gives each entry of a^T the number of the entry it
+// copies, and keeps the import of a's entries, numbered so, to a^T's; fill() then moves a's
+// values by that import: one exchange of a's values, where Tpetra's transposer builds a new
+// matrix (measured on Example 1 case 2's coupling at 100 x 100: perf/README.md). The values are
+// copies, so a^T is the transposer's to the bit.
+class KeptTranspose {
+ public:
+  void build(const Teuchos::RCP<const CrsMatrix>& a);
+  void fill(const CrsMatrix& a);
+  void update(bool graph, const Teuchos::RCP<const CrsMatrix>& a) { graph ? build(a) : fill(*a); }
+  const Teuchos::RCP<CrsMatrix>& matrix() const { return m_; }
+
+ private:
+  Teuchos::RCP<CrsMatrix> m_;
+  Teuchos::RCP<const Tpetra::Import<LocalId, GlobalId>> import_;
+  Teuchos::RCP<TpetraVector> from_, to_;  // a's values by entry number; m_'s
+};
 
 // A diagonal matrix over a vector's map.
 class KeptDiagonal {

@@ -260,16 +260,18 @@ class PressureProjection {
   }
 
   // system_ = composed_ + ns (ns the network's rows of the step, R N S_H) on a graph kept while
-  // ns's pattern and composed_'s graph do not change: the values are written in place
-  // (composed_'s, then ns's added: the same sums on every step, whether the graph is new or
-  // kept, so a restart, which builds it again, gives the same matrix) and the preconditioner's
-  // numeric part alone is computed again when the refresh interval is up
+  // ns's and composed_'s graphs do not change (`graph`: ns's is new): the values are written in
+  // place (composed_'s, then ns's added: the same sums on every step, whether the graph is new
+  // or kept, so a restart, which builds it again, gives the same matrix) and the
+  // preconditioner's numeric part alone is computed again when the refresh interval is up
   // (LinearSolve::refresh).
-  void compose(const CrsMatrix& ns);
+  void compose(const CrsMatrix& ns, bool graph);
 
-  // The network's rows of the step (CrackBlock, header): storage, flow and exchange on the
-  // fracture pressures' rows, the exchange on its points' pore-pressure rows.
-  Teuchos::RCP<CrsMatrix> network_rows(const CrackBlock& crack) const;
+  // The network's rows of the step (CrackBlock, header) into network_: storage, flow and
+  // exchange on the fracture pressures' rows, the exchange on its points' pore-pressure rows.
+  // Written in place while the entries' rows and columns are the step before's; built again
+  // when they changed (points joined, bonds broke): then true (on every rank).
+  bool network_values(const CrackBlock& crack);
 
   // The system's graphs (structure_: built again) and values. Every value comes from the
   // kept-graph operations (include/mupm/solvers/kept_matrix.hpp) whether the graph is new or
@@ -303,13 +305,25 @@ class PressureProjection {
   KeptSum rest_, static_, ras_, composed_;
   // coupling_: B_0 over the points; joint_coupling_: [B_0; B_f]; coupling_s_: B, its rows
   // scaled by sigma_ (S_r, 1 on the network's rows); coupling_t_: [B_0; B_f]^T
-  Teuchos::RCP<CrsMatrix> coupling_s_, coupling_t_, scaled_coupling_, scaled_static_, system_;
+  Teuchos::RCP<CrsMatrix> coupling_s_, scaled_coupling_, scaled_static_, system_;
+  KeptTranspose coupling_t_;
   Teuchos::RCP<TpetraVector> inverse_mass_, keep_, saturation_, sigma_;
   std::vector<double> seen_;
-  // compose: ns's pattern, composed_'s entries' positions in system_, ns's entries' positions
-  std::vector<GlobalId> pattern_;
+  // network_values: N (the network's rows), its entries' (row, column) gids in its order and
+  // their positions in N's values; ns_: R N S_H (a product with images); ns_graph_: S_H's
+  // graph changed since the last compose. compose: composed_'s and ns_'s entries' positions in
+  // system_.
+  Teuchos::RCP<CrsMatrix> network_, ns_;
+  std::vector<GlobalId> network_pattern_;
+  std::vector<std::size_t> network_at_;
+  KeptProduct ns_product_;
+  bool ns_graph_ = true;
   std::vector<std::size_t> base_;
   std::vector<std::size_t> where_;
+  // compose: composed_'s entry at each of where_'s positions (-1: none), and whether composed_'s
+  // values changed since (assemble): if not, only where_'s positions are written
+  std::vector<std::ptrdiff_t> under_;
+  bool composed_changed_ = true;
   std::vector<LocalId> crack_points_;
   std::vector<char> crack_held_;
   std::vector<std::vector<std::pair<GlobalId, double>>> crack_coupling_;

@@ -150,8 +150,8 @@ class FlowOperator {
     g_.build(grad_map, overlap, owned, grad_map, rows_.gr);
     wg_.build(grad_map, overlap, owned, grad_map, rows_.wgr);
     l_.build(owned, overlap, owned, owned, rows_.lap);
-    gt_ = transpose(g_.matrix());
-    flux_.build(*gt_, false, *wg_.matrix(), false);
+    gt_.build(g_.matrix());
+    flux_.build(*gt_.matrix(), false, *wg_.matrix(), false);
     sum_.build(1.0, *flux_.matrix(), 1.0, *l_.matrix());
   }
   void fill(const Discretization<Dim>& disc, const FluidParams& prm, const Scalars& alpha,
@@ -159,11 +159,11 @@ class FlowOperator {
     flow_rows(disc, prm, alpha, rows_);
     if (geometry) {
       g_.fill(rows_.gr);
-      gt_ = transpose(g_.matrix());
+      gt_.fill(*g_.matrix());
     }
     wg_.fill(rows_.wgr);
     l_.fill(rows_.lap);
-    flux_.fill(*gt_, false, *wg_.matrix(), false);
+    flux_.fill(*gt_.matrix(), false, *wg_.matrix(), false);
     sum_.fill(1.0, *flux_.matrix(), 1.0, *l_.matrix());
   }
   const Teuchos::RCP<CrsMatrix>& matrix() const { return sum_.matrix(); }
@@ -171,7 +171,7 @@ class FlowOperator {
  private:
   FlowRows rows_;
   KeptRows g_, wg_, l_;
-  Teuchos::RCP<CrsMatrix> gt_;
+  KeptTranspose gt_;
   KeptProduct flux_;
   KeptSum sum_;
 };
