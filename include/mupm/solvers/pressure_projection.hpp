@@ -141,10 +141,12 @@
 // opening the correction reached, over the bonds the solve used; the jump of a point's mean
 // opening when its bonds break enters the next step's balance); the correction's work on the
 // faces is part of projection_work. The network's rows change every step (apertures set
-// Lambda): with a network their values are added to the kept rest in place on a kept graph, and
-// the preconditioner's factors are computed again every Preconditioner Refresh Interval steps
-// and after each checkpoint, kept in between (compose, LinearSolve::refresh); the joint map
-// changes when points join, or B_f's columns when bonds break: then the graphs are built again.
+// Lambda): with a network their values are written in place on a graph of their own, kept
+// while their rows and columns are (network_values), and added to the kept rest in place, at
+// their own positions alone while the rest's values are unchanged (compose); no matrix is built
+// and no product formed in a step without image points. The preconditioner follows
+// LinearSolve::refresh (below); the joint map changes when points join, or B_f's columns when
+// bonds break: then the graphs are built again.
 // Measured
 // (tests/solvers/test_fracture_flow.cpp, FractureFlowSemiImplicit): incompressible water injected
 // into a free slot opens it by the injected volume to 1e-10 at the drained step; against the
@@ -160,7 +162,10 @@
 // the graphs hold every bond of the lists (a broken one at zero) and change only with the
 // network's points or B_f's columns; B~ = diag(S_r) B_0 and the transposes of B_0 and of the
 // flow's gradient are kept while the bonds are, so a change of S_r, k_r or the densities needs
-// no transpose. The preconditioner then follows LinearSolve::refresh (kept up to Preconditioner
+// no transpose, and a broken bond's new values reach them by one exchange of values on their
+// kept graphs (KeptTranspose). The products B M^-1 B^T and Gr^T W Gr are formed again in full
+// on their kept graphs (Tpetra's reuse kernel): the rows a broken bond touches are not
+// recomputed alone. The preconditioner then follows LinearSolve::refresh (kept up to Preconditioner
 // Refresh Interval steps or until a solve takes Refresh Iteration Growth times the iterations of
 // the first after its set-up, renewed after each checkpoint). The solve is CG where A is
 // symmetric (no image points; krylov below), GMRES otherwise, each preconditioned by one V-cycle
