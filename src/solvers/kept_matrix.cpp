@@ -31,23 +31,24 @@ void KeptTranspose::build(const Teuchos::RCP<const CrsMatrix>& a) {
   auto copies = Teuchos::rcp(
       new Map(invalid, Teuchos::ArrayView<const GlobalId>(source), 0, entries->getComm()));
   import_ = Teuchos::rcp(new Tpetra::Import<LocalId, GlobalId>(entries, copies));
-  from_ = Teuchos::rcp(new TpetraVector(entries));
-  to_ = Teuchos::rcp(new TpetraVector(copies));
   fill(*a);
 }
 
+// The two vectors live only here: a refill's memory is not held through the solves and the
+// preconditioner's set-up (in 3D the values of B_0^T alone are gigabytes).
 void KeptTranspose::fill(const CrsMatrix& a) {
   const auto values = a.getLocalValuesView();
+  TpetraVector from(import_->getSourceMap()), to(import_->getTargetMap());
   {
-    auto v = from_->getLocalViewHost(Tpetra::Access::OverwriteAll);
+    auto v = from.getLocalViewHost(Tpetra::Access::OverwriteAll);
     if (v.extent(0) != values.extent(0))
       throw std::logic_error("KeptTranspose: the matrix's graph changed");
     for (std::size_t q = 0; q < values.extent(0); ++q)
       v(q, 0) = values(q);
   }
-  to_->doImport(*from_, *import_, Tpetra::INSERT);
+  to.doImport(from, *import_, Tpetra::INSERT);
   const auto t = m_->getLocalValuesView();
-  const auto v = to_->getLocalViewHost(Tpetra::Access::ReadOnly);
+  const auto v = to.getLocalViewHost(Tpetra::Access::ReadOnly);
   for (std::size_t q = 0; q < t.extent(0); ++q)
     t(q) = v(q, 0);
 }

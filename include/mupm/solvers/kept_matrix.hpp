@@ -307,8 +307,8 @@ class KeptTranspose {
 
  private:
   Teuchos::RCP<CrsMatrix> m_;
+  // a's entries, by their numbers, to m_'s
   Teuchos::RCP<const Tpetra::Import<LocalId, GlobalId>> import_;
-  Teuchos::RCP<TpetraVector> from_, to_;  // a's values by entry number; m_'s
 };
 
 // A diagonal matrix over a vector's map.
