@@ -18,11 +18,11 @@ auto PressureProjection<Dim>::step(double dt, const FluidParams& prm, const Flui
     // ns = R N S_H: without images S_H = diag(keep) (assemble), so ns is N scaled by keep on
     // both sides (exact: keep is 0 or 1), on N's graph; with images a product on a kept graph.
     if (!images_any_) {
-      copy_values(ns_, *network_, graph);
+      copy_values(ns_, *network_.matrix(), graph);
       ns_->rightScale(*keep_);
     } else {
       graph = graph || ns_graph_;
-      ns_product_.update(graph, *network_, false, *s_h_.matrix(), false);
+      ns_product_.update(graph, *network_.matrix(), false, *s_h_.matrix(), false);
       ns_ = ns_product_.matrix();
     }
     ns_->leftScale(*keep_);
@@ -70,7 +70,7 @@ auto PressureProjection<Dim>::step(double dt, const FluidParams& prm, const Flui
   if (nonzero[0]) {
     static_.matrix()->apply(c, ac);  // A c = (static part + the network's rows) c
     if (any_crack_)
-      network_->apply(c, ac, Teuchos::NO_TRANS, 1.0, 1.0);
+      network_.matrix()->apply(c, ac, Teuchos::NO_TRANS, 1.0, 1.0);
   } else {
     ac.putScalar(0.0);
   }
@@ -256,68 +256,37 @@ void PressureProjection<Dim>::compose(const CrsMatrix& ns, bool graph) {
 template <int Dim>
 bool PressureProjection<Dim>::network_values(const CrackBlock& crack) {
   const auto& p = disc_.points;
-  // The entries in a fixed order: per network point, its pore-pressure row (exchange), then its
-  // fracture-pressure row (exchange, flows, diagonal).
-  std::vector<GlobalId> pattern;  // (row, column) gids
-  std::vector<double> values;
+  // Per network point its pore-pressure row (exchange), then its fracture-pressure row
+  // (exchange, flows, diagonal); the (row, column) gids in that order.
+  GlobalRows rows;
+  std::vector<GlobalId> pattern;
   for (std::size_t k = 0; k < crack.point.size(); ++k) {
     const GlobalId g = p.gid(crack.point[k]), gf = crack.offset + g;
     const double ex = crack.exchange[k];
-    pattern.insert(pattern.end(), {g, g, g, gf, gf, g});
-    values.insert(values.end(), {ex, -ex, -ex});
+    rows.push_back({g, {{g, ex}, {gf, -ex}}});
+    auto& f = rows.emplace_back(gf, std::vector<std::pair<GlobalId, double>>{{g, -ex}}).second;
     double diag = crack.storage[k] + ex;
     for (const auto& e : crack.flow[k]) {
-      pattern.insert(pattern.end(), {gf, e.first});
-      values.push_back(-e.second);
+      f.push_back({e.first, -e.second});
       diag += e.second;
     }
-    pattern.insert(pattern.end(), {gf, gf});
-    values.push_back(diag);
+    f.push_back({gf, diag});
   }
-  int rebuild = network_.is_null() || network_->getRowMap().get() != joint_.get() ||
+  for (const auto& r : rows)
+    for (const auto& e : r.second)
+      pattern.insert(pattern.end(), {r.first, e.first});
+  int rebuild = network_.matrix().is_null() ||
+                        network_.matrix()->getRowMap().get() != joint_.get() ||
                         pattern != network_pattern_
                     ? 1
                     : 0;
   MPI_Allreduce(MPI_IN_PLACE, &rebuild, 1, MPI_INT, MPI_MAX, comm_);
   if (rebuild) {
-    // Each row's entries, listed in the order above.
-    const LocalId rows = LocalId(joint_->getNodeNumElements());
-    std::vector<std::vector<std::size_t>> of_row{std::size_t(rows)};
-    for (std::size_t q = 0; q < values.size(); ++q)
-      of_row[std::size_t(joint_->getLocalElement(pattern[2 * q]))].push_back(q);
-    std::size_t longest = 1;
-    for (const auto& r : of_row)
-      longest = std::max(longest, r.size());
-    network_ = Teuchos::rcp(new CrsMatrix(joint_, longest));
-    std::vector<GlobalId> cols;
-    const std::vector<double> zeros(longest, 0.0);
-    for (LocalId r = 0; r < rows; ++r) {
-      const auto& qs = of_row[std::size_t(r)];
-      if (qs.empty())
-        continue;
-      cols.clear();
-      for (const std::size_t q : qs)
-        cols.push_back(pattern[2 * q + 1]);
-      network_->insertGlobalValues(joint_->getGlobalElement(r),
-                                   Teuchos::ArrayView<const GlobalId>(cols),
-                                   Teuchos::ArrayView<const double>(zeros.data(), cols.size()));
-    }
-    network_->fillComplete(joint_, joint_);
-    std::vector<std::size_t> order;
-    const auto listed = detail::positions_in(*network_, [&](LocalId r, auto&& add) {
-      for (const std::size_t q : of_row[std::size_t(r)]) {
-        order.push_back(q);
-        add(pattern[2 * q + 1]);
-      }
-    });
-    network_at_.assign(values.size(), 0);
-    for (std::size_t k = 0; k < listed.size(); ++k)
-      network_at_[order[k]] = listed[k];
+    network_.build(nullptr, joint_, rows, joint_, joint_);
     network_pattern_ = std::move(pattern);
+  } else {
+    network_.fill(nullptr, rows);
   }
-  const auto v = network_->getLocalValuesView();
-  for (std::size_t q = 0; q < values.size(); ++q)
-    v(network_at_[q]) = values[q];
   return rebuild != 0;
 }
 

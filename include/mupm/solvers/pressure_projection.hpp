@@ -314,13 +314,12 @@ class PressureProjection {
   KeptTranspose coupling_t_;
   Teuchos::RCP<TpetraVector> inverse_mass_, keep_, saturation_, sigma_;
   std::vector<double> seen_;
-  // network_values: N (the network's rows), its entries' (row, column) gids in its order and
-  // their positions in N's values; ns_: R N S_H (a product with images); ns_graph_: S_H's
-  // graph changed since the last compose. compose: composed_'s and ns_'s entries' positions in
-  // system_.
-  Teuchos::RCP<CrsMatrix> network_, ns_;
+  // network_values: N (the network's rows) and its entries' (row, column) gids in their order;
+  // ns_: R N S_H (a product with images); ns_graph_: S_H's graph changed since the last
+  // compose. compose: composed_'s and ns_'s entries' positions in system_.
+  KeptJoin network_;
+  Teuchos::RCP<CrsMatrix> ns_;
   std::vector<GlobalId> network_pattern_;
-  std::vector<std::size_t> network_at_;
   KeptProduct ns_product_;
   bool ns_graph_ = true;
   std::vector<std::size_t> base_;
