@@ -22,7 +22,7 @@ auto PressureProjection<Dim>::step(double dt, const FluidParams& prm, const Flui
       ns_->rightScale(*keep_);
     } else {
       graph = graph || ns_graph_;
-      ns_product_.update(graph, *network_.matrix(), false, *s_h_.matrix(), false);
+      ns_product_.update(graph, *network_.matrix(), *s_h_.matrix());
       ns_ = ns_product_.matrix();
     }
     ns_->leftScale(*keep_);
@@ -375,8 +375,7 @@ void PressureProjection<Dim>::assemble(double dt, const FluidParams& prm, const 
   copy_values(scaled_coupling_, *coupling_s_, build);
   scaled_coupling_->rightScale(*inverse_mass_);
   const auto& flow = *joint_flow_.matrix();
-  projection_.update(build, *scaled_coupling_, false, *coupling_t_.matrix(), false);
-  projection_.matrix()->rightScale(*sigma_);
+  projection_.update(build, *scaled_coupling_, *coupling_t_.matrix(), sigma_.get());
   storage_.update(build, storage);
   rest_.update(build, dt * dt, *projection_.matrix(), 1.0, *storage_.matrix());
   static_.update(build, dt, flow, 1.0, *rest_.matrix());
@@ -448,8 +447,8 @@ void PressureProjection<Dim>::assemble(double dt, const FluidParams& prm, const 
     scaled_static_->rightScale(*keep_);
     ras = scaled_static_;
   } else {
-    flow_s_.update(build, flow, false, *s_h_.matrix(), false);
-    rest_s_.update(build, *rest_.matrix(), false, *s_p_.matrix(), false);
+    flow_s_.update(build, flow, *s_h_.matrix());
+    rest_s_.update(build, *rest_.matrix(), *s_p_.matrix());
     ras_.update(build, dt, *flow_s_.matrix(), 1.0, *rest_s_.matrix());
     ras = ras_.matrix();
   }

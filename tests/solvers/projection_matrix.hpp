@@ -3,7 +3,9 @@
 #ifndef MUPM_TESTS_PROJECTION_MATRIX_HPP
 #define MUPM_TESTS_PROJECTION_MATRIX_HPP
 
+#include <mpi.h>
 #include <cmath>
+#include <map>
 
 #include "mupm/solvers/fluid_solver.hpp"
 #include "mupm/solvers/linear_solve.hpp"
@@ -17,6 +19,31 @@ namespace test {
 inline double field(const double* x, int c) {
   return std::sin(37 * x[0] + 3 * c) * std::cos(23 * x[1] - c) + 0.3 * std::sin(91 * x[0] * x[1]) +
          (x[2] != 0 ? 0.2 * std::cos(53 * x[2]) : 0.0);
+}
+
+// The largest |a_ij - b_ij| over every rank, each entry of a against b's at the same global row
+// and column; -1 where their graphs differ.
+inline double entry_difference(const CrsMatrix& a, const CrsMatrix& b) {
+  double d = a.getNodeNumEntries() == b.getNodeNumEntries() ? 0.0 : -1.0;
+  for (LocalId r = 0; d >= 0 && r < LocalId(a.getRowMap()->getNodeNumElements()); ++r) {
+    const GlobalId g = a.getRowMap()->getGlobalElement(r);
+    CrsMatrix::local_inds_host_view_type ia, ib;
+    CrsMatrix::values_host_view_type va, vb;
+    a.getLocalRowView(r, ia, va);
+    b.getLocalRowView(b.getRowMap()->getLocalElement(g), ib, vb);
+    std::map<GlobalId, double> row;
+    for (std::size_t k = 0; k < ia.extent(0); ++k)
+      row[a.getColMap()->getGlobalElement(ia(k))] = va(k);
+    if (ib.extent(0) != ia.extent(0))
+      d = -1;
+    for (std::size_t k = 0; d >= 0 && k < ib.extent(0); ++k) {
+      const auto it = row.find(b.getColMap()->getGlobalElement(ib(k)));
+      d = it == row.end() ? -1.0 : std::max(d, std::abs(it->second - vb(k)));
+    }
+  }
+  double all[2] = {d < 0 ? 1.0 : 0.0, d};
+  MPI_Allreduce(MPI_IN_PLACE, all, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return all[0] > 0 ? -1.0 : all[1];
 }
 
 // The projection's matrix A = dt^2 B~ M^-1 B~^T + dt V H + V C of the semi-implicit step for

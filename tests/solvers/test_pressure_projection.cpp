@@ -119,27 +119,8 @@ void check_flow_operator() {
   EXPECT_GT(xv.dot(y), 0) << "positive semi-definite: x . H x >= 0";
 }
 
-// Each entry of a against b's at the same global row and column, to the bit (the same graph).
 bool same_entries(const CrsMatrix& a, const CrsMatrix& b) {
-  bool same = a.getNodeNumEntries() == b.getNodeNumEntries();
-  for (LocalId r = 0; same && r < LocalId(a.getRowMap()->getNodeNumElements()); ++r) {
-    const GlobalId g = a.getRowMap()->getGlobalElement(r);
-    CrsMatrix::local_inds_host_view_type ia, ib;
-    CrsMatrix::values_host_view_type va, vb;
-    a.getLocalRowView(r, ia, va);
-    b.getLocalRowView(b.getRowMap()->getLocalElement(g), ib, vb);
-    std::map<GlobalId, double> row;
-    for (std::size_t k = 0; k < ia.extent(0); ++k)
-      row[a.getColMap()->getGlobalElement(ia(k))] = va(k);
-    same = ib.extent(0) == ia.extent(0);
-    for (std::size_t k = 0; same && k < ib.extent(0); ++k) {
-      const auto it = row.find(b.getColMap()->getGlobalElement(ib(k)));
-      same = it != row.end() && it->second == vb(k);
-    }
-  }
-  int all = same ? 1 : 0;
-  MPI_Allreduce(MPI_IN_PLACE, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  return all == 1;
+  return test::entry_difference(a, b) == 0;
 }
 
 // The kept graphs (include/mupm/solvers/kept_matrix.hpp): the flow operator and the coupling

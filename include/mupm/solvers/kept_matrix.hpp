@@ -26,6 +26,12 @@ namespace mupm {
 
 // Rows of (local column, value), the owned rows in order.
 using LocalRows = std::vector<std::vector<std::pair<LocalId, double>>>;
+// n empty rows, each keeping the memory it had (a refill writes the same rows again).
+inline void clear_rows(LocalRows& rows, std::size_t n) {
+  rows.resize(n);
+  for (auto& r : rows)
+    r.clear();
+}
 // Rows of (global row, (global column, value)).
 using GlobalRows = std::vector<std::pair<GlobalId, std::vector<std::pair<GlobalId, double>>>>;
 
@@ -257,25 +263,39 @@ class KeptSum {
   std::vector<std::size_t> pa_, pb_;
 };
 
-// op(a) op(b), Tpetra's product's graph kept (its values again by Tpetra's reuse kernel, which
-// writes the product on a fill-complete result's graph).
+// a b diag(s) (s over b's domain map, or none) on a graph kept while a's and b's are. build()
+// takes the graph of Tpetra's product and keeps b's rows at a's columns: their structure, and
+// the import of b's entries to them (numbered as in KeptTranspose). fill() imports b's values
+// and forms the product row by row with a dense accumulator; a row is formed again only when one
+// of its inputs (a's row, a b row it reaches, s at its columns) differs from the last fill's in
+// some bit, so the rows a broken bond does not reach keep their values, which are the ones a
+// full product would give (each row's sum is formed in the same order every time). Tpetra's
+// reuse kernel, used before, built the import of b's remote rows on every call and formed every
+// row (perf/README.md).
 class KeptProduct {
  public:
-  void build(const CrsMatrix& a, bool ta, const CrsMatrix& b, bool tb) {
-    m_ = Teuchos::rcp(new CrsMatrix(ta ? a.getDomainMap() : a.getRowMap(), 0));
-    Tpetra::MatrixMatrix::Multiply(a, ta, b, tb, *m_);
-    fill(a, ta, b, tb);
-  }
-  void fill(const CrsMatrix& a, bool ta, const CrsMatrix& b, bool tb) {
-    Tpetra::MatrixMatrix::Multiply(a, ta, b, tb, *m_);
-  }
-  void update(bool graph, const CrsMatrix& a, bool ta, const CrsMatrix& b, bool tb) {
-    graph ? build(a, ta, b, tb) : fill(a, ta, b, tb);
+  void build(const CrsMatrix& a, const CrsMatrix& b, const TpetraVector* s = nullptr);
+  void fill(const CrsMatrix& a, const CrsMatrix& b, const TpetraVector* s = nullptr);
+  void update(bool graph, const CrsMatrix& a, const CrsMatrix& b, const TpetraVector* s = nullptr) {
+    graph ? build(a, b, s) : fill(a, b, s);
   }
   const Teuchos::RCP<CrsMatrix>& matrix() const { return m_; }
+  // The rows the last fill formed, of matrix()'s local rows.
+  std::size_t rows_formed() const { return formed_; }
 
  private:
   Teuchos::RCP<CrsMatrix> m_;
+  // b's entries, by their numbers, to b's rows at a's columns (`ext`)
+  Teuchos::RCP<const Tpetra::Import<LocalId, GlobalId>> import_;
+  // s over b's domain map to m_'s columns (null: the same map)
+  Teuchos::RCP<const Tpetra::Import<LocalId, GlobalId>> scale_import_;
+  // ext in compressed rows (its row k is b's row at a's column k): m_'s local column of each
+  std::vector<std::size_t> ext_start_;
+  std::vector<LocalId> ext_col_;
+  // the last fill's inputs (compared bit for bit) and whether it scaled
+  std::vector<double> a_, ext_, s_;
+  bool scaled_ = false, fresh_ = true;
+  std::size_t formed_ = 0;
 };
 
 // dst: src's values on a copy of src's graph (copied when `graph`: a new graph).

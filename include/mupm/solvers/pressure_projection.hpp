@@ -163,9 +163,10 @@
 // network's points or B_f's columns; B~ = diag(S_r) B_0 and the transposes of B_0 and of the
 // flow's gradient are kept while the bonds are, so a change of S_r, k_r or the densities needs
 // no transpose, and a broken bond's new values reach them by one exchange of values on their
-// kept graphs (KeptTranspose). The products B M^-1 B^T and Gr^T W Gr are formed again in full
-// on their kept graphs (Tpetra's reuse kernel): the rows a broken bond touches are not
-// recomputed alone. The preconditioner then follows LinearSolve::refresh (kept up to Preconditioner
+// kept graphs (KeptTranspose). The products B M^-1 B^T and Gr^T W Gr are formed again on their
+// kept graphs only in the rows whose factors' values changed (KeptProduct): after a break, the
+// rows within two horizons of its bonds; after a change of S_r or the densities, all. The
+// sums after them are written again in full. The preconditioner then follows LinearSolve::refresh (kept up to Preconditioner
 // Refresh Interval steps or until a solve takes Refresh Iteration Growth times the iterations of
 // the first after its set-up, renewed after each checkpoint). The solve is CG where A is
 // symmetric (no image points; krylov below), GMRES otherwise, each preconditioned by one V-cycle

@@ -78,9 +78,9 @@ void flow_rows(const Discretization<Dim>& disc, const FluidParams& prm, const Sc
   const auto& b = disc.bonds;
   const auto& sh = disc.shape;
   const std::size_t n = p.n_owned;
-  out.gr.assign(n * Dim, {});
-  out.wgr.assign(n * Dim, {});
-  out.lap.assign(n, {});
+  clear_rows(out.gr, n * Dim);
+  clear_rows(out.wgr, n * Dim);
+  clear_rows(out.lap, n);
   for (std::size_t i = 0; i < n; ++i) {
     const double vi = p.volume(i), ai = alpha(i);
     double self_lap = 0;
@@ -89,7 +89,9 @@ void flow_rows(const Discretization<Dim>& disc, const FluidParams& prm, const Sc
     for (int k = 0; k < Dim * Dim; ++k)
       Kinv[k] = sh.Kinv(i, k);
     auto& lap = out.lap[i];
-    std::vector<std::pair<LocalId, double>> row[Dim];
+    std::vector<std::pair<LocalId, double>>* row[Dim];  // Gr's rows of i
+    for (int d = 0; d < Dim; ++d)
+      row[d] = &out.gr[i * Dim + d];
     double self[Dim] = {};
     for (BondIndex e = b.offsets(i); e < b.offsets(i + 1); ++e) {
       const LocalId j = b.neighbor(e);
@@ -106,7 +108,7 @@ void flow_rows(const Discretization<Dim>& disc, const FluidParams& prm, const Sc
         mat_vec<Dim, Dim>(Kinv, xi, c);
       }
       for (int d = 0; d < Dim; ++d) {
-        row[d].push_back({j, c[d] * vj});
+        row[d]->push_back({j, c[d] * vj});
         self[d] -= c[d] * vj;
       }
     }
@@ -118,18 +120,16 @@ void flow_rows(const Discretization<Dim>& disc, const FluidParams& prm, const Sc
         for (int c = 0; c < Dim; ++c)
           W[r * Dim + c] = vi * ((r == c ? lambda : 0.0) - ai * K[r * Dim + c]);
     }
-    for (int d = 0; d < Dim; ++d) {
-      row[d].push_back({LocalId(i), self[d]});
-      out.gr[i * Dim + d] = row[d];
-    }
+    for (int d = 0; d < Dim; ++d)
+      row[d]->push_back({LocalId(i), self[d]});
     // W Gr: row (i, d) = sum_e W_de Gr(i, e); the rows share their columns.
     for (int d = 0; d < Dim; ++d) {
       auto& w = out.wgr[i * Dim + d];
-      w = row[0];
+      w = *row[0];
       for (std::size_t k = 0; k < w.size(); ++k) {
         double s = 0;
         for (int e2 = 0; e2 < Dim; ++e2)
-          s += W[d * Dim + e2] * row[e2][k].second;
+          s += W[d * Dim + e2] * (*row[e2])[k].second;
         w[k].second = s;
       }
     }
@@ -151,7 +151,7 @@ class FlowOperator {
     wg_.build(grad_map, overlap, owned, grad_map, rows_.wgr);
     l_.build(owned, overlap, owned, owned, rows_.lap);
     gt_.build(g_.matrix());
-    flux_.build(*gt_.matrix(), false, *wg_.matrix(), false);
+    flux_.build(*gt_.matrix(), *wg_.matrix());
     sum_.build(1.0, *flux_.matrix(), 1.0, *l_.matrix());
   }
   void fill(const Discretization<Dim>& disc, const FluidParams& prm, const Scalars& alpha,
@@ -163,7 +163,7 @@ class FlowOperator {
     }
     wg_.fill(rows_.wgr);
     l_.fill(rows_.lap);
-    flux_.fill(*gt_.matrix(), false, *wg_.matrix(), false);
+    flux_.fill(*gt_.matrix(), *wg_.matrix());
     sum_.fill(1.0, *flux_.matrix(), 1.0, *l_.matrix());
   }
   const Teuchos::RCP<CrsMatrix>& matrix() const { return sum_.matrix(); }
@@ -215,7 +215,7 @@ void volume_coupling_rows(const Discretization<Dim>& disc, double biot, bool sat
   const auto& b = disc.bonds;
   const auto& sh = disc.shape;
   const std::size_t n = p.n_owned;
-  rows.assign(n, {});
+  clear_rows(rows, n);
   for (std::size_t i = 0; i < n; ++i) {
     if (p.fixed(i) & kFixedNoEnergy)
       continue;
