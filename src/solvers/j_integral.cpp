@@ -7,7 +7,7 @@ JIntegral<Dim>::JIntegral(Discretization<Dim>& disc, const JIntegralParams& prm,
                           const Damage<Dim>& damage, MPI_Comm comm)
     : disc_(disc), prm_(prm), damage_(damage), comm_(comm) {
   static_assert(Dim == 2 || Dim == 3);
-  terms_ = Vectors("mupm::j_integral_terms", disc.points.n_owned, 3 * prm.half.size());
+  terms_ = Vectors("mupm::j_integral_terms", disc.points.n_owned, 4 * prm.half.size());
   const Crack& c = disc.grid.cracks.front();
   double len = 0;
   for (int k = 0; k < 2; ++k) {
@@ -32,6 +32,8 @@ void JIntegral<Dim>::series(SeriesRow& row) const {
   row("j_integral", v[0].total);
   row("j_translational", v[0].translational);
   row("j_rotational", v[0].rotational);
+  if (prm_.face)
+    row("j_face", v[0].face);
   for (std::size_t k = 1; k < v.size(); ++k)
     row("j_integral_" + std::to_string(k + 1), v[k].total);
   if (prm_.criterion) {  // the crack the criterion grew: the pre-crack in the body + n da
@@ -83,29 +85,35 @@ auto JIntegral<Dim>::evaluate(const JContours& jc) const -> std::vector<Value> {
     throw std::logic_error("JIntegral::evaluate: no solid state attached (JIntegral::attach)");
   if constexpr (Dim == 2) {
     const auto& p = disc_.points;
-    j_integral_terms(p, disc_.bonds, sp_, *st_, jc, terms_);
+    if (prm_.face && p.applied_crack_force.extent(0) == 0)
+      throw std::logic_error("JIntegral::evaluate: the face term without the crack water's force");
+    const Vectors face = prm_.face ? p.applied_crack_force : Vectors();
+    j_integral_terms(p, disc_.bonds, sp_, *st_, jc, face, terms_);
     auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), terms_);
     // Per point with a term, for each contour: the translational part (its first two terms
-    // added) and the rotational part; summed over ranks exactly (core/exact_sum.hpp).
+    // added), the rotational part and the face term; summed over ranks exactly
+    // (core/exact_sum.hpp).
     std::vector<double> mine;
     std::size_t rows = 0;
     for (std::size_t i = 0; i < p.n_owned; ++i) {
       bool any = false;
-      for (int k = 0; k < 3 * nc; ++k)
+      for (int k = 0; k < 4 * nc; ++k)
         any = any || h(i, k) != 0;
       if (!any)
         continue;
       ++rows;
       for (int c = 0; c < nc; ++c) {
-        mine.push_back(h(i, 3 * c) + h(i, 3 * c + 1));
-        mine.push_back(h(i, 3 * c + 2));
+        mine.push_back(h(i, 4 * c) + h(i, 4 * c + 1));
+        mine.push_back(h(i, 4 * c + 2));
+        mine.push_back(h(i, 4 * c + 3));
       }
     }
-    const std::vector<double> sums = exact_sums(comm_, mine.data(), rows, 2 * nc);
+    const std::vector<double> sums = exact_sums(comm_, mine.data(), rows, 3 * nc);
     for (std::size_t c = 0; c < std::size_t(nc); ++c) {
-      out[c].translational = sums[2 * c];
-      out[c].rotational = sums[2 * c + 1];
-      out[c].total = out[c].translational + out[c].rotational;
+      out[c].translational = sums[3 * c];
+      out[c].rotational = sums[3 * c + 1];
+      out[c].face = sums[3 * c + 2];
+      out[c].total = out[c].translational + out[c].rotational + out[c].face;
     }
   }
   return out;

@@ -161,6 +161,8 @@ void KeptProduct::fill(const CrsMatrix& a, const CrsMatrix& b, const TpetraVecto
     ext_.swap(ext);
   }
   if (s) {
+    if (s->getMap()->getNodeNumElements() != m_->getDomainMap()->getNodeNumElements())
+      throw std::logic_error("KeptProduct: the scaling is not over the product's domain map");
     std::vector<double> sc(ncol);
     if (scale_import_.is_null()) {
       const auto v = s->getLocalViewHost(Tpetra::Access::ReadOnly);
@@ -193,6 +195,10 @@ void KeptProduct::fill(const CrsMatrix& a, const CrsMatrix& b, const TpetraVecto
   }
   // Each row summed by one thread in a's and b's storage order: the same values for any number
   // of threads, and for a row formed again or kept.
+  formed_ = formed.size();
+  fresh_ = false;
+  if (formed.empty())
+    return;
   using Exec = Kokkos::DefaultHostExecutionSpace;
   Kokkos::Experimental::UniqueToken<Exec> token;
   std::vector<double> acc(std::size_t(token.size()) * ncol, 0.0);
@@ -217,8 +223,6 @@ void KeptProduct::fill(const CrsMatrix& a, const CrsMatrix& b, const TpetraVecto
                          }
                          token.release(t);
                        });
-  formed_ = formed.size();
-  fresh_ = false;
 }
 
 }  // namespace mupm

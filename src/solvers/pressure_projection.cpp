@@ -25,6 +25,9 @@ auto PressureProjection<Dim>::step(double dt, const FluidParams& prm, const Flui
       ns_product_.update(graph, *network_.matrix(), *s_h_.matrix());
       ns_ = ns_product_.matrix();
     }
+    // In place on ns_product_'s rows too: keep is 0 or 1, so a row it keeps comes out the same
+    // scaled again, and a change of keep changes S_H's diagonal, which N's diagonal reaches,
+    // so the row is formed again (KeptProduct).
     ns_->leftScale(*keep_);
     compose(*ns_, graph);
   } else if (system_ != composed_.matrix()) {

@@ -5,6 +5,7 @@
 
 #include <mpi.h>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "mupm/solvers/fluid_solver.hpp"
@@ -38,7 +39,8 @@ inline double entry_difference(const CrsMatrix& a, const CrsMatrix& b) {
       d = -1;
     for (std::size_t k = 0; d >= 0 && k < ib.extent(0); ++k) {
       const auto it = row.find(b.getColMap()->getGlobalElement(ib(k)));
-      d = it == row.end() ? -1.0 : std::max(d, std::abs(it->second - vb(k)));
+      const double e = it == row.end() ? -1.0 : std::abs(it->second - vb(k));
+      d = e < 0 ? -1.0 : std::isnan(e) ? std::numeric_limits<double>::infinity() : std::max(d, e);
     }
   }
   double all[2] = {d < 0 ? 1.0 : 0.0, d};

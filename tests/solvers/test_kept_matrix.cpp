@@ -71,6 +71,34 @@ TEST(KeptMatrix, ProductFormsOnlyTheRowsAChangeReachesAndEqualsAFreshBuild) {
   EXPECT_EQ(global_sum((long long)c.rows_formed()), 0);
   EXPECT_EQ(test::entry_difference(*c.matrix(), *before), 0);
 
+  // A mass changed at one dof: a's entries in that column change, b does not; exactly the rows
+  // of a that change are formed (a's rows are the product's).
+  {
+    const auto a_before = Teuchos::rcp(new CrsMatrix(*a, Teuchos::Copy));
+    const GlobalId g = m.getMap()->getMaxAllGlobalIndex() / 2;
+    set_by_gid(m,
+               [&](GlobalId h) { return h == g ? 0.1 : 1.0 / (2.0 + std::sin(0.7 * double(h))); });
+    scaled();
+    long long changed = 0;
+    for (LocalId r = 0; r < LocalId(a->getNodeNumRows()); ++r) {
+      CrsMatrix::local_inds_host_view_type i0, i1;
+      CrsMatrix::values_host_view_type v0, v1;
+      a_before->getLocalRowView(r, i0, v0);
+      a->getLocalRowView(r, i1, v1);
+      bool row = false;
+      for (std::size_t k = 0; k < v1.extent(0); ++k)
+        row = row || v0(k) != v1(k);
+      changed += row;
+    }
+    c.fill(*a, *bt.matrix(), &s);
+    EXPECT_EQ(global_sum((long long)c.rows_formed()), global_sum(changed));
+    EXPECT_GT(global_sum(changed), 5);
+    EXPECT_LT(global_sum(changed), rows);
+    KeptProduct fresh;
+    fresh.build(*a, *bt.matrix(), &s);
+    EXPECT_EQ(test::entry_difference(*c.matrix(), *fresh.matrix()), 0);
+  }
+
   // Break the bonds across x0 (both ends agree on every rank): the rows of B_0 M^-1 at the broken
   // bonds' ends and the dofs' rows of B_0^T around them change, and the product's rows that
   // reach them are formed again, not all.
@@ -121,6 +149,10 @@ TEST(KeptMatrix, ProductFormsOnlyTheRowsAChangeReachesAndEqualsAFreshBuild) {
   auto unscaled = Teuchos::rcp(new CrsMatrix(a->getRowMap(), 0));
   Tpetra::MatrixMatrix::Multiply(*a, false, *bt.matrix(), false, *unscaled);
   EXPECT_LT(test::entry_difference(*c.matrix(), *unscaled), 1e-14 * unscaled->getFrobeniusNorm());
+  // And scaled again: every row.
+  c.fill(*a, *bt.matrix(), &s);
+  EXPECT_EQ(global_sum((long long)c.rows_formed()), rows);
+  EXPECT_EQ(test::entry_difference(*c.matrix(), *fresh.matrix()), 0);
 }
 
 }  // namespace

@@ -39,9 +39,25 @@
 // there no bond crosses, and the W term is int W n.d ds along the face, with the W of the
 // points of the last row (dx/2 inside it) at full weight.
 //
+// The crack water's forces on the faces (Fracture Flow with Crack Water Force = Face Pressure,
+// kernels/fracture_flow.hpp), not in the paper's J. Rice's J assumes traction-free faces; with
+// a load on them the divergence theorem over the region between the contour and a small one
+// around the tip, in equilibrium with the body force density b, gives
+//   J_tip = J_Gamma - int_{B1} b.u_1 dA,
+// since div(W d - sigma^T u_1) = -div(sigma).u_1 = b.u_1 (W_1 = sigma : grad u_1; the micropolar
+// terms add m : grad th_1, balanced the same way by the couple stresses, and a pressure applies
+// no couple, so no th_1 term follows). For a pressure p on the faces of an opening w (b the face
+// traction p n over each face) this is J_Gamma + int_0^{s_Gamma} p (dw/ds) ds, s the distance
+// behind the tip up to the contour: for a Griffith crack J_Gamma alone is short by the fraction
+// (4/pi) sqrt(2r/a - (r/a)^2) of J, r the distance the contour runs behind the tip. mupm applies
+// the water as force densities on the fracture points (Points::applied_crack_force, the ones the
+// step applied), so the face term is the sum over the points in B1
+//   J_face = - sum_{i in B1} b_i.u_1(i) V_i,
+// which the point's u_1 (its nonlocal gradient, one-sided at a face) makes path-independent.
+// With Crack Water Force = Eq 17 (the water on the bonds) the face term is left out.
+//
 // Left out, as in the paper's J: kinetic energy (J is that of a static field; in a running crack
-// the contours differ), and the crack water's forces on the faces (Fracture Flow): with water in
-// the crack J is not path-independent.
+// the contours differ).
 //
 // Force state: the one the bond energy uses (Fracture->Bond Energy Force State): with pore water
 // and Effective (default), the skeleton's, T-bar = T + S_r p* K^-1 xi (the paper's eqs 23, 30:
@@ -67,6 +83,7 @@ struct JIntegralParams {
   double critical = 0;                      // G_cr [J/m^2]
   double increment = 0;                     // Delta a [m]
   double max_speed = 0;                     // the tip's speed cap c_R [m/s] (0: none)
+  bool face = false;  // the crack water's face term (Fracture Flow with Face Pressure; header)
 };
 
 // Contours (faces on cell faces), the crack direction d (unit), and the thickness h.
@@ -79,15 +96,18 @@ struct JContours {
   Box body;  // the lattice (real body and boundary layers): its faces are free or held faces
 };
 
-// Per owned point i and contour c: out(i, 3c + 0) the W term, 3c + 1 the u terms, 3c + 2 the
-// theta terms (each already signed as it enters J, per unit thickness). u, theta, eps, kappa,
-// P1, P2, winv (and P1w when allocated) current on the ghosts, as solid pass 2 leaves them.
+// Per owned point i and contour c: out(i, 4c + 0) the W term, 4c + 1 the u terms, 4c + 2 the
+// theta terms, 4c + 3 the face term of the force density `face` (owned points; none when not
+// allocated) (each already signed as it enters J, per unit thickness). u, theta, eps, kappa, P1,
+// P2, winv (and P1w when allocated) current on the ghosts, as solid pass 2 leaves them.
 // Effective: the bond forces include P1w's pore-water part (P1w allocated), a compile-time
 // choice so that the bond loop tests no run-time option (j_integral_terms dispatches).
 template <bool Effective>
 void j_integral_terms_variant(const Points<2>& pts, const Bonds& bonds, const SolidParams& prm,
-                              const SolidState<2>& st, const JContours& jc, const Vectors& out) {
+                              const SolidState<2>& st, const JContours& jc, const Vectors& face,
+                              const Vectors& out) {
   constexpr int Dim = 2, R = 1;
+  const bool loaded = face.extent(0) > 0;
   auto offsets = bonds.offsets;
   auto neighbor = bonds.neighbor;
   auto intact = bonds.intact;
@@ -114,7 +134,7 @@ void j_integral_terms_variant(const Points<2>& pts, const Bonds& bonds, const So
         const double Wi = energy(i) / vol(i);
         for (int ci = 0; ci < c.count; ++ci) {
           const Box& b = c.box[ci];
-          double w = 0, tr = 0, rot = 0;
+          double w = 0, tr = 0, rot = 0, fc = 0;
           // W term: the points at dx/2 from an edge, within the edge's span; an edge at or
           // beyond the body's face runs along the face, where the last row carries W (header).
           for (int a = 0; a < Dim; ++a) {
@@ -135,8 +155,10 @@ void j_integral_terms_variant(const Points<2>& pts, const Bonds& bonds, const So
               w -= Wi * c.dx * c.d[a];  // along the face x_a = lo
             }
           }
-          // Bond terms: i in B1 (inside), j in B2 (outside).
+          // Bond terms: i in B1 (inside), j in B2 (outside); the face term of i in B1.
           if (in_box<Dim>(b, xi_, 0.0)) {
+            if (loaded)
+              fc = -(face(i, 0) * gi[0] + face(i, 1) * gi[1]) * vol(i) / c.thickness;
             for (BondIndex bd = offsets(i); bd < offsets(i + 1); ++bd) {
               if (!intact(bd))
                 continue;
@@ -186,19 +208,21 @@ void j_integral_terms_variant(const Points<2>& pts, const Bonds& bonds, const So
               rot -= (Mij * hj - Mji * hi - 0.5 * (xTij * hj + xTji * hi)) * vv;
             }
           }
-          out(i, 3 * ci + 0) = w;
-          out(i, 3 * ci + 1) = tr;
-          out(i, 3 * ci + 2) = rot;
+          out(i, 4 * ci + 0) = w;
+          out(i, 4 * ci + 1) = tr;
+          out(i, 4 * ci + 2) = rot;
+          out(i, 4 * ci + 3) = fc;
         }
       });
 }
 
 inline void j_integral_terms(const Points<2>& pts, const Bonds& bonds, const SolidParams& prm,
-                             const SolidState<2>& st, const JContours& jc, const Vectors& out) {
+                             const SolidState<2>& st, const JContours& jc, const Vectors& face,
+                             const Vectors& out) {
   if (st.P1w.extent(0) > 0)
-    j_integral_terms_variant<true>(pts, bonds, prm, st, jc, out);
+    j_integral_terms_variant<true>(pts, bonds, prm, st, jc, face, out);
   else
-    j_integral_terms_variant<false>(pts, bonds, prm, st, jc, out);
+    j_integral_terms_variant<false>(pts, bonds, prm, st, jc, face, out);
 }
 
 }  // namespace mupm

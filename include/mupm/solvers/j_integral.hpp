@@ -44,7 +44,8 @@ template <int Dim>
 class JIntegral : public Module {
  public:
   struct Value {
-    double total = 0, translational = 0, rotational = 0;  // per unit thickness [J/m^2]
+    // per unit thickness [J/m^2]; face: the crack water's term (kernels/j_integral.hpp)
+    double total = 0, translational = 0, rotational = 0, face = 0;
   };
 
   JIntegral(Discretization<Dim>& disc, const JIntegralParams& prm, const Damage<Dim>& damage,
@@ -57,7 +58,8 @@ class JIntegral : public Module {
 
   const char* name() const override { return "j_integral"; }
   void globals(GlobalRefs& g) override;
-  // j_integral, j_translational, j_rotational of the first contour; j_integral_<k> of contour k;
+  // j_integral, j_translational, j_rotational (and j_face with the crack water's face term) of
+  // the first contour; j_integral_<k> of contour k;
   // with the J criterion j_crack_length, the pre-crack's part inside the body + n Delta a.
   void series(SeriesRow& row) const override;
 

@@ -269,7 +269,10 @@ class KeptSum {
 // and forms the product row by row with a dense accumulator; a row is formed again only when one
 // of its inputs (a's row, a b row it reaches, s at its columns) differs from the last fill's in
 // some bit, so the rows a broken bond does not reach keep their values, which are the ones a
-// full product would give (each row's sum is formed in the same order every time). Tpetra's
+// full product would give (each row's sum is formed in the same order every time), so a caller
+// must not change matrix()'s values unless a kept row would come out the same. The inputs of
+// the last fill are kept for the comparison: a's values and b's rows at a's columns, about
+// twice b's values. Tpetra's
 // reuse kernel, used before, built the import of b's remote rows on every call and formed every
 // row (perf/README.md).
 class KeptProduct {

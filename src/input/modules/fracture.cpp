@@ -233,7 +233,10 @@ InputModule j_integral_input() {
           "The micropolar J-integral (eqs 30, 125-126) around the tip of the first pre-crack, "
           "on rectangular contours centred on the tip (2D). Time-series columns j_integral, "
           "j_translational, j_rotational (first contour) and j_integral_<k> (contour k >= 2), "
-          "per unit thickness [J/m^2 = Pa m]. The tip: with Fracture->Bond Breakage = "
+          "per unit thickness [J/m^2 = Pa m]; with Fracture Flow and Crack Water Force = Face "
+          "Pressure J includes the crack water's work on the faces inside the contour (column "
+          "j_face), which keeps it path-independent with water in the crack. The tip: with "
+          "Fracture->Bond Breakage = "
           "J-Integral the pre-crack's End advanced by the crack's increments, otherwise the "
           "tracked tip (crack_tip_x/y). Derivation and discretization in "
           "include/mupm/kernels/j_integral.hpp.",
