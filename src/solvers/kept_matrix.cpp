@@ -149,7 +149,7 @@ void KeptProduct::fill(const CrsMatrix& a, const CrsMatrix& b, const TpetraVecto
     throw std::logic_error("KeptProduct: a's graph changed");
   const bool all = fresh_ || (s != nullptr) != scaled_;
   // What changed since the last fill: b's rows at a's columns, s at m_'s columns, a's rows.
-  std::vector<char> ext_changed(nk, all), col_changed(ncol, all), row(rows, all);
+  std::vector<char> ext_changed(nk, all), col_changed(ncol, all);
   {
     std::vector<double> ext(ext_.size());
     import_values(
@@ -183,7 +183,7 @@ void KeptProduct::fill(const CrsMatrix& a, const CrsMatrix& b, const TpetraVecto
   scaled_ = s != nullptr;
   std::vector<LocalId> formed;
   for (std::size_t r = 0; r < rows; ++r) {
-    bool f = row[r];
+    bool f = all;
     for (auto q = al.graph.row_map(r); q < al.graph.row_map(r + 1); ++q) {
       f = f || differs(al.values(q), a_[q]) || ext_changed[std::size_t(al.graph.entries(q))];
       a_[q] = al.values(q);

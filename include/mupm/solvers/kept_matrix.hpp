@@ -266,15 +266,13 @@ class KeptSum {
 // a b diag(s) (s over b's domain map, or none) on a graph kept while a's and b's are. build()
 // takes the graph of Tpetra's product and keeps b's rows at a's columns: their structure, and
 // the import of b's entries to them (numbered as in KeptTranspose). fill() imports b's values
-// and forms the product row by row with a dense accumulator; a row is formed again only when one
-// of its inputs (a's row, a b row it reaches, s at its columns) differs from the last fill's in
-// some bit, so the rows a broken bond does not reach keep their values, which are the ones a
-// full product would give (each row's sum is formed in the same order every time), so a caller
-// must not change matrix()'s values unless a kept row would come out the same. The inputs of
-// the last fill are kept for the comparison: a's values and b's rows at a's columns, about
-// twice b's values. Tpetra's
-// reuse kernel, used before, built the import of b's remote rows on every call and formed every
-// row (perf/README.md).
+// and forms a row, with a dense accumulator, only when one of its inputs (a's row, a b row it
+// reaches, s at its columns) differs in some bit from the last fill's; each row is summed in the
+// same order every time, so a kept row is the one a full product would give. Hence a caller
+// must not change matrix()'s values unless a kept row would come out the same. The last fill's
+// inputs are kept for the comparison (a's values and b's rows at a's columns: about twice b's
+// values). Tpetra's reuse kernel, used before, imported b's remote rows on every call and
+// formed every row (perf/README.md).
 class KeptProduct {
  public:
   void build(const CrsMatrix& a, const CrsMatrix& b, const TpetraVector* s = nullptr);

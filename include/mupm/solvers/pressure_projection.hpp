@@ -166,11 +166,11 @@
 // kept graphs (KeptTranspose). The products B M^-1 B^T and Gr^T W Gr are formed again on their
 // kept graphs only in the rows whose factors' values changed (KeptProduct): after a break, the
 // rows within two horizons of its bonds; after a change of S_r or the densities, all. The
-// sums after them are written again in full. The preconditioner then follows LinearSolve::refresh (kept up to Preconditioner
-// Refresh Interval steps or until a solve takes Refresh Iteration Growth times the iterations of
-// the first after its set-up, renewed after each checkpoint). The solve is CG where A is
-// symmetric (no image points; krylov below), GMRES otherwise, each preconditioned by one V-cycle
-// of hypre's algebraic multigrid of A (include/mupm/solvers/amg_preconditioner.hpp; its
+// sums after them are written again in full. The preconditioner then follows LinearSolve::refresh
+// (kept up to Preconditioner Refresh Interval steps or until a solve takes Refresh Iteration Growth
+// times the iterations of the first after its set-up, renewed after each checkpoint). The solve is
+// CG where A is symmetric (no image points; krylov below), GMRES otherwise, each preconditioned by
+// one V-cycle of hypre's algebraic multigrid of A (include/mupm/solvers/amg_preconditioner.hpp; its
 // iterations stay bounded as the body is refined), or by ILU(k) of A less its small (far)
 // entries (Pressure Solve -> Preconditioner, include/mupm/solvers/linear_solve_settings.hpp).
 #ifndef MUPM_SOLVERS_PRESSURE_PROJECTION_HPP
