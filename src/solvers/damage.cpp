@@ -36,25 +36,45 @@ void Damage<Dim>::series(SeriesRow& row) const {
 template <int Dim>
 auto Damage<Dim>::crack_tip() const -> Tip {
   const Crack& c = disc_.grid.cracks.front();
+  double S[3] = {0, 0, 0}, T[3] = {0, 0, 0}, d[3] = {0, 0, 0}, len = 0;
+  for (int k = 0; k < Dim; ++k) {
+    S[k] = c.a[k];
+    T[k] = Dim == 2 ? c.b[k] : c.a[k] + c.b[k];
+    d[k] = T[k] - S[k];
+    len += d[k] * d[k];
+  }
+  len = std::sqrt(len);
+  for (int k = 0; k < Dim; ++k)
+    d[k] /= len;
+  const Reach r = farthest(T, d);
+  // The pre-crack's part inside the real body: its length along d, and the middle of its tip
+  // edge there (a 3D rectangle overhanging the body measured as the same cut clipped to it).
+  const CrackPart part = crack_inside<Dim>(c, disc_.grid.body());
+  Tip tip;
+  tip.length = inside_length(c) + std::max(r.s, 0.0);
+  for (int k = 0; k < Dim; ++k)
+    tip.x[k] = r.s > 0 ? r.x[k]
+               : part.s1 >= part.s0
+                   ? S[k] + part.s1 * (T[k] - S[k]) + (Dim == 3 ? part.t * c.c[k] : 0.0)
+                   : T[k];
+  return tip;
+}
+
+template <int Dim>
+auto Damage<Dim>::farthest(const double* T, const double* d) const -> Reach {
   Ahead ahead;
-  double S[3] = {0, 0, 0}, len = 0;
   ahead.x = disc_.points.x;
   ahead.frac = disc_.points.fracture;
   ahead.flags = disc_.points.flags;
   for (int k = 0; k < Dim; ++k) {
-    S[k] = c.a[k];
-    ahead.T[k] = Dim == 2 ? c.b[k] : c.a[k] + c.b[k];
-    ahead.d[k] = ahead.T[k] - S[k];
-    len += ahead.d[k] * ahead.d[k];
+    ahead.T[k] = T[k];
+    ahead.d[k] = d[k];
   }
-  len = std::sqrt(len);
-  for (int k = 0; k < Dim; ++k)
-    ahead.d[k] /= len;
   const std::size_t n = disc_.points.n_owned;
   auto gid = disc_.points.gid;
   auto x = disc_.points.x;
   // Largest s, then the lowest global id among the points that have it, then its position.
-  double best = 0;
+  Reach r;
   Kokkos::parallel_reduce(
       "mupm::Diagnostics::crack_extent", range(0, n),
       KOKKOS_LAMBDA(const std::size_t i, double& m) {
@@ -62,19 +82,11 @@ auto Damage<Dim>::crack_tip() const -> Tip {
         if (ahead(i, s))
           m = s > m ? s : m;
       },
-      Kokkos::Max<double>(best));
-  MPI_Allreduce(MPI_IN_PLACE, &best, 1, MPI_DOUBLE, MPI_MAX, comm_);
-  // The pre-crack's part inside the real body: its length along d, and the middle of its tip
-  // edge there (a 3D rectangle overhanging the body measured as the same cut clipped to it).
-  const CrackPart part = crack_inside<Dim>(c, disc_.grid.body());
-  Tip tip;
-  tip.length = inside_length(c) + std::max(best, 0.0);
-  for (int k = 0; k < Dim; ++k)
-    tip.x[k] = part.s1 >= part.s0
-                   ? S[k] + part.s1 * (ahead.T[k] - S[k]) + (Dim == 3 ? part.t * c.c[k] : 0.0)
-                   : ahead.T[k];
-  if (!(best > 0))
-    return tip;
+      Kokkos::Max<double>(r.s));
+  MPI_Allreduce(MPI_IN_PLACE, &r.s, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  if (!(r.s > 0))
+    return r;
+  const double best = r.s;
   long long mine = std::numeric_limits<long long>::max(), who = -1;
   Kokkos::parallel_reduce(
       "mupm::Diagnostics::crack_tip", range(0, n),
@@ -94,9 +106,9 @@ auto Damage<Dim>::crack_tip() const -> Tip {
             acc += x(i, k);
         },
         xk);
-    MPI_Allreduce(&xk, &tip.x[k], 1, MPI_DOUBLE, MPI_SUM, comm_);
+    MPI_Allreduce(&xk, &r.x[k], 1, MPI_DOUBLE, MPI_SUM, comm_);
   }
-  return tip;
+  return r;
 }
 
 template <int Dim>

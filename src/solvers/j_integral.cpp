@@ -8,73 +8,102 @@ JIntegral<Dim>::JIntegral(Discretization<Dim>& disc, const JIntegralParams& prm,
     : disc_(disc), prm_(prm), damage_(damage), comm_(comm) {
   static_assert(Dim == 2 || Dim == 3);
   terms_ = Vectors("mupm::j_integral_terms", disc.points.n_owned, 4 * prm.half.size());
-  const Crack& c = disc.grid.cracks.front();
-  double len = 0;
-  for (int k = 0; k < 2; ++k) {
-    d_[k] = c.b[k] - c.a[k];
-    len += d_[k] * d_[k];
-  }
-  for (int k = 0; k < 2; ++k)
-    d_[k] /= std::sqrt(len);
+  for (const CrackTip& t : crack_tips(disc.grid.cracks, disc.grid.body()))
+    tips_.push_back({t});
+  if (tips_.empty())  // the input check (src/input/modules/fracture.cpp) refuses it
+    throw std::logic_error("JIntegral: no pre-crack end lies inside the body");
 }
+
+namespace {
+// Column `name` of tip k (0-based): the name itself for the first tip, name_tip<k+1> else.
+std::string tip_column(const std::string& name, std::size_t k) {
+  return k == 0 ? name : name + "_tip" + std::to_string(k + 1);
+}
+}  // namespace
 
 template <int Dim>
 void JIntegral<Dim>::globals(GlobalRefs& g) {
-  if (prm_.criterion) {
-    g("advances", advances_);
-    g("last_advance_time", last_advance_);
-  }
+  if (prm_.criterion)
+    for (std::size_t k = 0; k < tips_.size(); ++k) {
+      g(tip_column("advances", k), tips_[k].advances);
+      g(tip_column("last_advance_time", k), tips_[k].last_advance);
+    }
 }
 
 template <int Dim>
 void JIntegral<Dim>::series(SeriesRow& row) const {
-  const auto v = evaluate();
-  row("j_integral", v[0].total);
-  row("j_translational", v[0].translational);
-  row("j_rotational", v[0].rotational);
-  if (prm_.face)
-    row("j_face", v[0].face);
-  for (std::size_t k = 1; k < v.size(); ++k)
-    row("j_integral_" + std::to_string(k + 1), v[k].total);
-  if (prm_.criterion) {  // the crack the criterion grew: the pre-crack in the body + n da
-    const Crack& c = disc_.grid.cracks.front();
-    row("j_crack_length", damage_.inside_length(c) + double(advances_) * prm_.increment);
+  for (std::size_t t = 0; t < tips_.size(); ++t) {
+    const auto v = evaluate(t);
+    row(tip_column("j_integral", t), v[0].total);
+    row(tip_column("j_translational", t), v[0].translational);
+    row(tip_column("j_rotational", t), v[0].rotational);
+    if (prm_.face)
+      row(tip_column("j_face", t), v[0].face);
+    for (std::size_t k = 1; k < v.size(); ++k)
+      row(tip_column("j_integral", t) + "_" + std::to_string(k + 1), v[k].total);
   }
+  if (!prm_.criterion)
+    return;
+  // The crack the criterion grew: the first pre-crack in the body + its tips' n Delta a.
+  double grown = 0;
+  for (const Tip& t : tips_)
+    if (t.at.crack == 0)
+      grown += double(t.advances) * prm_.increment;
+  row("j_crack_length", damage_.inside_length(disc_.grid.cracks.front()) + grown);
+  if (tips_.size() > 1)
+    for (std::size_t k = 0; k < tips_.size(); ++k)
+      row("j_crack_length_tip" + std::to_string(k + 1),
+          tips_[k].at.base + double(tips_[k].advances) * prm_.increment);
 }
 
 template <int Dim>
-std::array<double, 2> JIntegral<Dim>::tip() const {
-  const Crack& c = disc_.grid.cracks.front();
+std::array<double, 2> JIntegral<Dim>::tip(std::size_t k) const {
+  const Tip& t = tips_.at(k);
   if (prm_.criterion)
-    return {c.b[0] + double(advances_) * prm_.increment * d_[0],
-            c.b[1] + double(advances_) * prm_.increment * d_[1]};
-  const auto t = damage_.crack_tip();
-  return {t.x[0], t.x[1]};
+    return {t.at.x[0] + double(t.advances) * prm_.increment * t.at.d[0],
+            t.at.x[1] + double(t.advances) * prm_.increment * t.at.d[1]};
+  const double T[3] = {t.at.x[0], t.at.x[1], 0}, d[3] = {t.at.d[0], t.at.d[1], 0};
+  const auto r = damage_.farthest(T, d);
+  if (!(r.s > 0))
+    return t.at.x;
+  return {r.x[0], r.x[1]};
 }
 
 template <int Dim>
-JContours JIntegral<Dim>::contours(const std::array<double, 2>& tip) const {
+JContours JIntegral<Dim>::contours(const std::array<double, 2>& at, std::size_t k) const {
   const auto& g = disc_.grid;
   JContours jc;
   jc.count = int(prm_.half.size());
-  jc.d[0] = d_[0];
-  jc.d[1] = d_[1];
+  jc.d[0] = tips_.at(k).at.d[0];
+  jc.d[1] = tips_.at(k).at.d[1];
   jc.thickness = g.thickness;
   jc.dx = g.dx;
-  auto face = [&](int k, double v) {
-    return g.origin[k] + std::round((v - g.origin[k]) / g.dx) * g.dx;
+  auto face = [&](int a, double v) {
+    return g.origin[a] + std::round((v - g.origin[a]) / g.dx) * g.dx;
   };
-  for (int k = 0; k < 2; ++k) {
-    jc.body.lo[k] = g.origin[k] - g.layers[k][0] * g.dx;
-    jc.body.hi[k] = g.origin[k] + double(g.counts[k] + g.layers[k][1]) * g.dx;
+  for (int a = 0; a < 2; ++a) {
+    jc.body.lo[a] = g.origin[a] - g.layers[a][0] * g.dx;
+    jc.body.hi[a] = g.origin[a] + double(g.counts[a] + g.layers[a][1]) * g.dx;
   }
   for (int c = 0; c < jc.count; ++c)
-    for (int k = 0; k < 2; ++k) {  // the tip to a face first, so that the box is centred on it
-      const double t = face(k, tip[k]), h = std::round(prm_.half[c][k] / g.dx) * g.dx;
-      jc.box[c].lo[k] = t - h;
-      jc.box[c].hi[k] = t + h;
+    for (int a = 0; a < 2; ++a) {  // the tip to a face first, so that the box is centred on it
+      const double t = face(a, at[a]), h = std::round(prm_.half[c][a] / g.dx) * g.dx;
+      jc.box[c].lo[a] = t - h;
+      jc.box[c].hi[a] = t + h;
     }
   return jc;
+}
+
+template <int Dim>
+bool JIntegral<Dim>::holds_other(std::size_t k,
+                                 const std::vector<std::array<double, 2>>& now) const {
+  const JContours jc = contours(now[k], k);
+  for (std::size_t m = 0; m < now.size(); ++m)
+    for (int c = 0; m != k && c < jc.count; ++c)
+      if (now[m][0] >= jc.box[c].lo[0] && now[m][0] <= jc.box[c].hi[0] &&
+          now[m][1] >= jc.box[c].lo[1] && now[m][1] <= jc.box[c].hi[1])
+        return true;
+  return false;
 }
 
 template <int Dim>
@@ -122,24 +151,39 @@ auto JIntegral<Dim>::evaluate(const JContours& jc) const -> std::vector<Value> {
 template <int Dim>
 Breakage JIntegral<Dim>::advance(double time) {
   Breakage br;
-  const auto t = tip();
   const auto& g = disc_.grid;
-  for (int k = 0; k < 2; ++k)  // the crack has run through the body
-    if (t[k] < g.origin[k] || t[k] >= g.origin[k] + double(g.counts[k]) * g.dx)
-      return br;
-  if (advances_ > 0 && prm_.max_speed > 0 &&
-      time - last_advance_ < prm_.increment / prm_.max_speed * (1 - 1e-9))
-    return br;
-  if (!(evaluate(contours(t))[0].total >= prm_.critical))
-    return br;
-  last_advance_ = time;
-  Crack seg;
-  for (int k = 0; k < 2; ++k) {
-    seg.a[k] = t[k];
-    seg.b[k] = t[k] + prm_.increment * d_[k];
+  std::vector<std::array<double, 2>> now(tips_.size());
+  for (std::size_t k = 0; k < tips_.size(); ++k)
+    now[k] = tip(k);
+  // Every tip's decision on the bonds of before this call, then the breaks: a tip's J does not
+  // see another tip's increment of the same step (a symmetric crack's tips stay symmetric).
+  std::vector<std::size_t> grow;
+  for (std::size_t k = 0; k < tips_.size(); ++k) {
+    const Tip& tp = tips_[k];
+    const auto& t = now[k];
+    bool out = false;  // the crack has run through the body
+    for (int a = 0; a < 2; ++a)
+      out = out || t[a] < g.origin[a] || t[a] >= g.origin[a] + double(g.counts[a]) * g.dx;
+    if (out || holds_other(k, now))
+      continue;
+    if (tp.advances > 0 && prm_.max_speed > 0 &&
+        time - tp.last_advance < prm_.increment / prm_.max_speed * (1 - 1e-9))
+      continue;
+    if (evaluate(contours(t, k))[0].total >= prm_.critical)
+      grow.push_back(k);
   }
-  br.bonds = break_crossing<Dim>(disc_.points, disc_.bonds, seg);
-  advances_ += 1;
+  for (std::size_t k : grow) {
+    Tip& tp = tips_[k];
+    const auto& t = now[k];
+    tp.last_advance = time;
+    Crack seg;
+    for (int a = 0; a < 2; ++a) {
+      seg.a[a] = t[a];
+      seg.b[a] = t[a] + prm_.increment * tp.at.d[a];
+    }
+    br.bonds += break_crossing<Dim>(disc_.points, disc_.bonds, seg);
+    tp.advances += 1;
+  }
   return br;
 }
 

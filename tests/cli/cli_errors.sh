@@ -306,6 +306,17 @@ base "$crack" '' | jlist '' |
 expect j_no_contour 2 'mupm->Fracture->Bond Breakage' 'mupm->J-Integral->Half Widths'
 base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3, 4}"/><Parameter name="Half Heights" type="Array(double)" value="{3}"/>' >j_sizes.xml
 expect j_sizes 2 'mupm->J-Integral->Half Heights' 'one per contour'
+# ... a crack with no end inside the body, a contour that holds the other tip, an increment
+# above one spacing.
+through='<ParameterList name="Pre-Cracks"><ParameterList name="c"><Parameter name="Start" type="Array(double)" value="{-0.01, 0.05}"/><Parameter name="End" type="Array(double)" value="{0.21, 0.05}"/></ParameterList></ParameterList>'
+base "$through" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/>' >j_no_tip.xml
+expect j_no_tip 2 'mupm->J-Integral->Half Widths' 'no end inside'
+centre='<ParameterList name="Pre-Cracks"><ParameterList name="c"><Parameter name="Start" type="Array(double)" value="{0.08, 0.05}"/><Parameter name="End" type="Array(double)" value="{0.12, 0.05}"/></ParameterList></ParameterList>'
+base "$centre" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3, 4}"/>' >j_other_tip.xml
+expect j_other_tip 2 'mupm->J-Integral->Half Widths' 'contour 2 around tip 1' 'holds tip 2'
+base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/><Parameter name="Crack Increment" type="double" value="0.015"/>' |
+  sed 's|  <ParameterList name="Solver">|  <ParameterList name="Fracture"><Parameter name="Bond Breakage" type="string" value="J-Integral"/><Parameter name="Critical Energy Release Rate" type="double" value="10"/></ParameterList>\n&|' >j_increment.xml
+expect j_increment 2 'mupm->J-Integral->Crack Increment' 'exceeds one Spacing'
 # Drucker-Prager: no cohesion, a residual cohesion above the initial one.
 base '' '' | sed 's|<Parameter name="Bulk Modulus"|<Parameter name="Model" type="string" value="Micropolar Drucker-Prager"/>&|' >dp_no_cohesion.xml
 expect dp_no_cohesion 2 'mupm->Materials->Cohesion' 'must be > 0'

@@ -65,6 +65,7 @@
 #ifndef MUPM_J_INTEGRAL_HPP
 #define MUPM_J_INTEGRAL_HPP
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -85,6 +86,40 @@ struct JIntegralParams {
   double max_speed = 0;                     // the tip's speed cap c_R [m/s] (0: none)
   bool face = false;  // the crack water's face term (Fracture Flow with Face Pressure; header)
 };
+
+// A crack tip of the J-integral: an end of a pre-crack (2D segment Start -> End) that lies
+// strictly inside the real body, the direction d (unit) in which it grows (End: Start -> End;
+// Start: End -> Start), the pre-crack it belongs to, and its share of that crack's length inside
+// the body at the start (half of it when both ends are tips, all of it when one is).
+struct CrackTip {
+  std::array<double, 2> x{}, d{};
+  std::size_t crack = 0;
+  double base = 0;
+};
+
+// The tips of `cracks` inside `body`, crack by crack, End before Start.
+inline std::vector<CrackTip> crack_tips(const std::vector<Crack>& cracks, const Box& body) {
+  std::vector<CrackTip> tips;
+  for (std::size_t c = 0; c < cracks.size(); ++c) {
+    const Crack& k = cracks[c];
+    const double len = std::hypot(k.b[0] - k.a[0], k.b[1] - k.a[1]);
+    if (!(len > 0))
+      continue;
+    auto inside = [&](const double* p) {
+      return p[0] > body.lo[0] && p[0] < body.hi[0] && p[1] > body.lo[1] && p[1] < body.hi[1];
+    };
+    const bool end = inside(k.b), start = inside(k.a);
+    // The part inside the body: all of it with both ends inside, else clipped (crack_inside).
+    const CrackPart part = crack_inside<2>(k, body);
+    const double share = std::max(part.s1 - part.s0, 0.0) * len / (end && start ? 2.0 : 1.0);
+    const double d[2] = {(k.b[0] - k.a[0]) / len, (k.b[1] - k.a[1]) / len};
+    if (end)
+      tips.push_back({{k.b[0], k.b[1]}, {d[0], d[1]}, c, share});
+    if (start)
+      tips.push_back({{k.a[0], k.a[1]}, {-d[0], -d[1]}, c, share});
+  }
+  return tips;
+}
 
 // Contours (faces on cell faces), the crack direction d (unit), and the thickness h.
 struct JContours {

@@ -56,6 +56,15 @@ class Damage : public Module {
   // The first pre-crack's length and tip now (header). Collective.
   Tip crack_tip() const;
 
+  // The farthest fracture point of the real body away from the pre-crack beyond T along the
+  // unit direction d (header): s = (x - T).d, the lowest global id among equals, and its
+  // position; s <= 0 when there is none beyond T. Collective.
+  struct Reach {
+    double s = 0;
+    std::array<double, 3> x{};
+  };
+  Reach farthest(const double* T, const double* d) const;
+
   // Length of a crack's part inside the real body along its direction (crack_inside).
   double inside_length(const Crack& c) const;
 

@@ -1,23 +1,27 @@
 // The J-integral module (paper eqs 125-126, Algorithm 3; kernel and derivation in
-// include/mupm/kernels/j_integral.hpp): J on rectangular contours around the tip of the first
-// pre-crack, its time-series columns, and the J criterion.
+// include/mupm/kernels/j_integral.hpp): J on rectangular contours around every crack tip, its
+// time-series columns, and the J criterion.
 //
-// The tip. With the J criterion (Fracture->Bond Breakage = J-Integral) the crack is the
-// pre-crack's segment Start -> End grown by n increments Delta a along its direction d (n is
-// kept across a restart); the tip is End + n Delta a d. Otherwise the tip is the tracked one of
-// the damage module (crack_tip_x/y: the farthest fracture point along d, or End before growth).
-// Each contour is centred on the tip with the given half width (along x) and half height, its
-// edges moved to the nearest cell faces; the contours move with the tip.
+// The tips: every pre-crack end strictly inside the real body (crack_tips: a centre crack has
+// two, an edge crack from a face one), numbered crack by crack, End before Start; each grows
+// along its own direction d (from the crack's other end). With the J criterion
+// (Fracture->Bond Breakage = J-Integral) tip k is its pre-crack end advanced by n_k increments
+// Delta a along d (n_k kept across a restart); otherwise it is the farthest fracture point
+// beyond the end along d (Damage::farthest), or the end before growth. Each contour is centred
+// on its tip with the given half width (along x) and half height, its edges moved to the
+// nearest cell faces; the contours move with the tip.
 //
-// The J criterion (Algorithm 3): after the solid's step (its forces of the new state), while
-// J/h of the first contour >= G_cr the crack advances one increment: the intact bonds that
-// cross the segment tip -> tip + Delta a d break (both copies: the test is on reference
-// positions, the same on every rank), at most one increment a step (the next step's J sees the
-// new tip and the new bond set). A tip outside the real body (the crack ran through) stays.
-// Speed cap (not in the paper's Algorithm 3): after an advance the next waits Delta a / c_R,
-// c_R the skeleton's Rayleigh wave speed, the limit of a running mode I crack's speed. Without
-// it the crack runs at Delta a / dt (above the wave speeds) for as long as the contours, whose
-// edges the field of the last increment has not reached yet, still show J >= G_cr.
+// The J criterion (Algorithm 3), tip by tip and each by its own J: after the solid's step (its
+// forces of the new state), while J/h of a tip's first contour >= G_cr that tip advances one
+// increment: the intact bonds that cross the segment tip -> tip + Delta a d break (both copies:
+// the test is on reference positions, the same on every rank), at most one increment a step per
+// tip (the next step's J sees the new tip and the new bond set). A tip outside the real body
+// (the crack ran through) stays, and so does a tip whose largest contour now holds another tip
+// (two cracks meeting: J would be that of both; the input check refuses it at the start).
+// Speed cap (not in the paper's Algorithm 3): after an advance the tip's next waits
+// Delta a / c_R, c_R the skeleton's Rayleigh wave speed, the limit of a running mode I crack's
+// speed. Without it the crack runs at Delta a / dt (above the wave speeds) for as long as the
+// contours, whose edges the field of the last increment has not reached yet, show J >= G_cr.
 //
 // Sums over ranks: every point's terms are added exactly (include/mupm/core/exact_sum.hpp), so
 // that J, and with it the criterion's decision, is the same to the last bit on any number of
@@ -57,29 +61,43 @@ class JIntegral : public Module {
   }
 
   const char* name() const override { return "j_integral"; }
+  // Per tip k: advances and last_advance_time (tip 1), advances_tip<k> and
+  // last_advance_time_tip<k> (k >= 2).
   void globals(GlobalRefs& g) override;
-  // j_integral, j_translational, j_rotational (and j_face with the crack water's face term) of
-  // the first contour; j_integral_<k> of contour k;
-  // with the J criterion j_crack_length, the pre-crack's part inside the body + n Delta a.
+  // Tip 1: j_integral, j_translational, j_rotational (and j_face with the crack water's face
+  // term) of the first contour, j_integral_<c> of contour c >= 2; tip k >= 2: the same names
+  // with the suffix _tip<k> (j_integral_tip<k>, j_integral_tip<k>_<c>, ...). With the J
+  // criterion j_crack_length, the first pre-crack's part inside the body + its tips' advances
+  // n Delta a, and, with two or more tips, j_crack_length_tip<k> for every tip: its share of
+  // its pre-crack (crack_tips) + n_k Delta a.
   void series(SeriesRow& row) const override;
 
-  // The tip now (header). Collective.
-  std::array<double, 2> tip() const;
+  std::size_t tips() const { return tips_.size(); }
+  // Tip k now (header). Collective.
+  std::array<double, 2> tip(std::size_t k = 0) const;
 
-  // The contours around `tip`, edges on the nearest cell faces.
-  JContours contours(const std::array<double, 2>& tip) const;
+  // The contours of tip k centred at `at`, edges on the nearest cell faces.
+  JContours contours(const std::array<double, 2>& at, std::size_t k = 0) const;
 
-  // J of every contour at the current tip (collective; the same bits on every rank).
-  std::vector<Value> evaluate() const { return evaluate(contours(tip())); }
+  // J of every contour at tip k now (collective; the same bits on every rank).
+  std::vector<Value> evaluate(std::size_t k = 0) const { return evaluate(contours(tip(k), k)); }
   std::vector<Value> evaluate(const JContours& jc) const;
 
-  // The J criterion (header) at time `time`: breaks the bonds across the next increment if
-  // J/h >= G_cr and the speed cap allows. Collective; returns the directed bonds broken on this
-  // rank.
+  // The J criterion (header) at time `time`: breaks the bonds across each tip's next increment
+  // where J/h >= G_cr and the speed cap allows. Collective; returns the directed bonds broken on
+  // this rank.
   Breakage advance(double time);
-  long long advances() const { return advances_; }
+  long long advances(std::size_t k = 0) const { return tips_[k].advances; }
 
  private:
+  struct Tip {
+    CrackTip at;               // the pre-crack end, direction and share (crack_tips)
+    long long advances = 0;    // increments it advanced (J criterion; a restart global)
+    double last_advance = 0;   // time of its last advance (J criterion; a restart global)
+  };
+  // Whether tip k's largest contour, centred at `at`, holds another tip of `now`.
+  bool holds_other(std::size_t k, const std::vector<std::array<double, 2>>& now) const;
+
   Discretization<Dim>& disc_;
   JIntegralParams prm_;
   const Damage<Dim>& damage_;
@@ -87,9 +105,7 @@ class JIntegral : public Module {
   const SolidState<Dim>* st_ = nullptr;
   SolidParams sp_;
   Vectors terms_;
-  double d_[2] = {1, 0};
-  long long advances_ = 0;   // increments the crack advanced (J criterion; a restart global)
-  double last_advance_ = 0;  // time of the last advance (J criterion; a restart global)
+  std::vector<Tip> tips_;
 };
 
 extern template class JIntegral<2>;

@@ -20,9 +20,10 @@ void declare_fracture(ParameterList& f) {
         "its energy W (eq 34, accumulated from the force and moment states over the run) "
         "reaches W_cr = 4 G_cr/(pi delta^4) in 3D (eq 36), 3 G_cr/(2 h delta^3) in 2D "
         "(derivation in include/mupm/kernels/fracture.hpp); the energy it holds is booked "
-        "as fracture dissipation. J-Integral (2D, Algorithm 3): the first pre-crack advances "
-        "by J-Integral->Crack Increment along its direction, at most once a step, whenever J/h "
-        "of the first J-Integral contour >= G_cr: the bonds across the increment break.",
+        "as fracture dissipation. J-Integral (2D, Algorithm 3): each crack tip (a pre-crack end "
+        "inside the body) advances by J-Integral->Crack Increment along its crack's direction, "
+        "at most once a step, whenever J/h of its first J-Integral contour >= G_cr: the bonds "
+        "across the increment break.",
         bond_breaking_options().validator());
   f.set("Critical Energy Release Rate", 0.0,
         "G_cr [J/m^2 = N/m] of the Energy and J-Integral criteria (> 0 with them).", at_least(0.0));
@@ -124,8 +125,8 @@ void declare_j_integral(ParameterList& j) {
         contour_units_options().validator());
   j.set("Crack Increment", 0.0,
         "Delta a [m] by which the J criterion (Fracture->Bond Breakage = J-Integral) advances "
-        "the crack each time J/h >= Critical Energy Release Rate (0: one Spacing; at most the "
-        "smallest contour half size).",
+        "a tip each time its J/h >= Critical Energy Release Rate (0: one Spacing; at most one "
+        "Spacing and the smallest contour half size).",
         at_least(0.0));
   j.set("Speed Cap", true,
         "J criterion: after an advance the next waits Delta a / c_R, c_R = c_s (0.862 + "
@@ -160,10 +161,6 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
                      ": the J-integral needs Solver->Physics = Micropolar Solid or "
                      "Hydro-Mechanical.");
   const ParameterList& d = input.sublist("Discretization");
-  if (d.sublist("Pre-Cracks").numParams() == 0)
-    throw InputError("Error, " + what +
-                     ": the J-integral's contours surround the tip of the first "
-                     "Discretization->Pre-Cracks entry; there is none.");
   if (w.size() > kMaxContours)
     throw InputError("Error, " + what + " lists " + std::to_string(w.size()) +
                      " contours; at most " + std::to_string(kMaxContours) + " are supported.");
@@ -183,29 +180,72 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
                          " has a half size of " + std::to_string(v * unit) +
                          " m, below one Spacing (" + std::to_string(dx) +
                          " m): a contour must hold the tip and the points around it.");
-  // The contours at the start, centred on the first pre-crack's End, inside the real body (their
-  // edges go to the nearest cell faces, at most dx/2 away): a contour beyond it runs through no
-  // material, and J came out 0.012 for 0.93 with a half width past the body's faces.
+  // The tips (kernels/j_integral.hpp, crack_tips): the pre-crack ends inside the real body.
   const ParameterList& cracks = d.sublist("Pre-Cracks");
-  const auto tip = cracks.sublist(cracks.name(cracks.begin())).get<Array<double>>("End");
+  std::vector<Crack> list;
+  for (auto it = cracks.begin(); it != cracks.end(); ++it) {
+    const ParameterList& c = cracks.sublist(cracks.name(it));
+    const auto a = c.get<Array<double>>("Start"), b = c.get<Array<double>>("End");
+    Crack cr;
+    for (int k = 0; k < 2; ++k) {
+      cr.a[k] = a[k];
+      cr.b[k] = b[k];
+    }
+    list.push_back(cr);
+  }
   const auto counts = d.get<Array<int>>("Counts");
   const auto ext = d.get<Array<double>>("Extents");
   const auto origin = d.get<Array<double>>("Origin");
-  for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
-    for (int a = 0; a < 2; ++a) {
-      const double o = origin.empty() ? 0.0 : origin[a];
-      const double n = counts.empty() ? std::round(ext[a] / dx) : double(counts[a]);
-      const double half = (a == 0 ? w[k] : h[k]) * unit;
-      if (tip[a] - half < o - 0.5 * dx || tip[a] + half > o + n * dx + 0.5 * dx) {
-        std::ostringstream m;
-        m << "Error, " << (a == 0 ? what : path_of(j, "Half Heights")) << ": contour " << k + 1
-          << " spans " << (a == 0 ? 'x' : 'y') << " = " << tip[a] - half << " to " << tip[a] + half
-          << " m around the first pre-crack's End, beyond the body (" << o << " to " << o + n * dx
-          << " m): the contour must run through the material. Give a smaller half size.";
-        throw InputError(m.str());
-      }
+  Box body;
+  for (int a = 0; a < 2; ++a) {
+    body.lo[a] = origin.empty() ? 0.0 : origin[a];
+    body.hi[a] = body.lo[a] + (counts.empty() ? std::round(ext[a] / dx) : double(counts[a])) * dx;
+  }
+  const auto tips = crack_tips(list, body);
+  if (tips.empty())
+    throw InputError("Error, " + what + ": the J-integral's contours surround the crack tips, " +
+                     "the ends of the Discretization->Pre-Cracks entries inside the body (" +
+                     std::to_string(body.lo[0]) + " to " + std::to_string(body.hi[0]) + " m by " +
+                     std::to_string(body.lo[1]) + " to " + std::to_string(body.hi[1]) +
+                     " m); there is " +
+                     (list.empty() ? std::string("no pre-crack") : std::string("no end inside")) +
+                     ".");
+  // Every tip's contours at the start inside the real body (their edges go to the nearest cell
+  // faces, at most dx/2 away; a contour beyond it runs through no material, and J came out 0.012
+  // for 0.93 with a half width past the body's faces) and free of the other tips.
+  auto where = [&](std::size_t t) {
+    std::ostringstream m;
+    m << "tip " << t + 1 << " (" << tips[t].x[0] << ", " << tips[t].x[1] << ") m";
+    return m.str();
+  };
+  for (std::size_t t = 0; t < tips.size(); ++t)
+    for (Teuchos::Ordinal k = 0; k < w.size(); ++k) {
+      double half[2] = {w[k] * unit, h[k] * unit};
+      for (int a = 0; a < 2; ++a)
+        if (tips[t].x[a] - half[a] < body.lo[a] - 0.5 * dx ||
+            tips[t].x[a] + half[a] > body.hi[a] + 0.5 * dx) {
+          std::ostringstream m;
+          m << "Error, " << (a == 0 ? what : path_of(j, "Half Heights")) << ": contour " << k + 1
+            << " spans " << (a == 0 ? 'x' : 'y') << " = " << tips[t].x[a] - half[a] << " to "
+            << tips[t].x[a] + half[a] << " m around " << where(t) << ", beyond the body ("
+            << body.lo[a] << " to " << body.hi[a]
+            << " m): the contour must run through the material. Give a smaller half size.";
+          throw InputError(m.str());
+        }
+      for (std::size_t o = 0; o < tips.size(); ++o)
+        if (o != t && std::abs(tips[o].x[0] - tips[t].x[0]) <= half[0] + 0.5 * dx &&
+            std::abs(tips[o].x[1] - tips[t].x[1]) <= half[1] + 0.5 * dx)
+          throw InputError("Error, " + what + " / Half Heights: contour " + std::to_string(k + 1) +
+                           " around " + where(t) + " holds " + where(o) +
+                           ": J around one tip would hold the other's field. Give a smaller half "
+                           "size, or cracks farther apart.");
     }
   const double inc = j.get<double>("Crack Increment");
+  if (criterion && inc > dx * (1 + 1e-12))
+    throw InputError("Error, " + path_of(j, "Crack Increment") + " = " + std::to_string(inc) +
+                     " m exceeds one Spacing (" + std::to_string(dx) +
+                     " m): an increment breaks the bonds across it at once, and one longer "
+                     "than a spacing skips the lattice's cells (0: one Spacing).");
   for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
     if (criterion && std::min(w[k], h[k]) * unit < inc)
       throw InputError("Error, " + path_of(j, "Crack Increment") + " = " + std::to_string(inc) +
@@ -230,15 +270,20 @@ InputModule fracture_input() {
 
 InputModule j_integral_input() {
   return {"J-Integral",
-          "The micropolar J-integral (eqs 30, 125-126) around the tip of the first pre-crack, "
-          "on rectangular contours centred on the tip (2D). Time-series columns j_integral, "
-          "j_translational, j_rotational (first contour) and j_integral_<k> (contour k >= 2), "
+          "The micropolar J-integral (eqs 30, 125-126) around every crack tip (each pre-crack "
+          "end inside the body: a centre crack has two, an edge crack one; numbered crack by "
+          "crack, End before Start), on rectangular contours centred on the tip (2D). "
+          "Time-series columns j_integral, j_translational, j_rotational (first contour) and "
+          "j_integral_<k> (contour k >= 2) of tip 1, the same with the suffix _tip<t> for tip "
+          "t >= 2 (j_integral_tip2, j_integral_tip2_2, ...), "
           "per unit thickness [J/m^2 = Pa m]; with Fracture Flow and Crack Water Force = Face "
           "Pressure J includes the crack water's work on the faces inside the contour (column "
           "j_face), which keeps it path-independent with water in the crack. The tip: with "
           "Fracture->Bond Breakage = "
-          "J-Integral the pre-crack's End advanced by the crack's increments, otherwise the "
-          "tracked tip (crack_tip_x/y). Derivation and discretization in "
+          "J-Integral the pre-crack's end advanced by its increments (columns j_crack_length, "
+          "the first pre-crack's length, and with two or more tips j_crack_length_tip<t>, tip "
+          "t's share of its pre-crack plus its advances), otherwise the farthest fracture point "
+          "beyond the end along the crack. Derivation and discretization in "
           "include/mupm/kernels/j_integral.hpp.",
           declare_j_integral, check_j, nullptr};
 }
