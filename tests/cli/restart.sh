@@ -141,6 +141,8 @@ check solid-traction inputs/quickstart.xml 40 8 "s|(<Parameter name=\"Boundary L
 check fracture tests/cli/fracture_small.xml 440 11
 # The J criterion (Algorithm 3): the crack advances by increments from step ~200.
 check fracture-j tests/cli/fracture_small.xml 440 13 's|value="Energy"/>|value="J-Integral"/>|; s|  <ParameterList name="Boundary Conditions">|  <ParameterList name="J-Integral"><Parameter name="Half Widths" type="Array(double)" value="{4, 5}"/></ParameterList>\n&|'
+# The J criterion at a centre crack's two tips, each with its own advances (two more globals).
+check fracture-j-centre tests/cli/fracture_small.xml 440 15 's|value="Energy"/>|value="J-Integral"/>|; s|value="\{-0.01, 0.05\}"|value="{0.03, 0.05}"|; s|value="\{0.02, 0.05\}"|value="{0.07, 0.05}"|; s|  <ParameterList name="Boundary Conditions">|  <ParameterList name="J-Integral"><Parameter name="Half Widths" type="Array(double)" value="{4, 5}"/></ParameterList>\n&|'
 # The same plate saturated, hydro-mechanical (soft water so that dt stays stable): breakage
 # with pore water (effective force state, strain-reference shift, fluid re-evaluation).
 check fracture-hm tests/cli/fracture_small.xml 440 16 's|value="Micropolar Solid"|value="Hydro-Mechanical"|; s|<ParameterList name="Fracture">|<ParameterList name="Fluid"><Parameter name="Hydraulic Conductivity" type="double" value="1e-6"/><Parameter name="Fluid Bulk Modulus" type="double" value="2.2e7"/></ParameterList><ParameterList name="Fracture">|' 

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 
+#include "mupm/input/model.hpp"
 #include "mupm/solvers/crack_face_force.hpp"
 #include "mupm/solvers/damage.hpp"
 #include "static_solve.hpp"
@@ -25,9 +26,13 @@ inline double sent_factor(double aw) {
          std::cos(t);
 }
 
+// Example 2's skeleton (nu = 0.30, E = 72 GPa) with mu_c and l small.
+inline const MicropolarElastic kClassical =
+    MicropolarElastic::from_bulk_shear(60e9, 27.7e9, 27.7e9 * 1e-4, 1e-5);
+
 // An edge-cracked plate solved for its static equilibrium (tests/solvers/static_solve.hpp):
-// nx x ny points of spacing dx, horizon factor m, the crack from the left face to x = a along
-// y = H/2 (a cell face).
+// nx x ny points of spacing dx, horizon factor m, the crack from the left face (or from x =
+// start: a centre crack) to x = a along y = H/2 (a cell face).
 struct StaticPlate {
   GridSpec<2> g;
   Discretization<2> disc;
@@ -37,13 +42,14 @@ struct StaticPlate {
 };
 
 inline std::unique_ptr<StaticPlate> static_plate(int nx, int ny, double dx, double m, double a,
-                                                 const MicropolarElastic& law) {
+                                                 const MicropolarElastic& law,
+                                                 double start = -0.01) {
   auto P = std::make_unique<StaticPlate>();
   P->g = box<2>({nx, ny}, m, dx);
   P->W = nx * dx;
   P->H = ny * dx;
   Crack crack;
-  crack.a[0] = -0.01;
+  crack.a[0] = start;
   crack.a[1] = 0.5 * P->H;
   crack.b[0] = a;
   crack.b[1] = 0.5 * P->H;

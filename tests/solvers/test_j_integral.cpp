@@ -30,14 +30,11 @@ namespace {
 using test::cell;
 using test::crack_water_load;
 using test::hold;
+using test::kClassical;
 using test::sent_factor;
 using test::static_plate;
 using test::StaticPlate;
 using test::tension;
-
-// Example 2's skeleton (nu = 0.30, E = 72 GPa) with mu_c and l small.
-const MicropolarElastic kClassical =
-    MicropolarElastic::from_bulk_shear(60e9, 27.7e9, 27.7e9 * 1e-4, 1e-5);
 
 struct KField {
   double K = 1e6;  // stress-intensity factor [Pa m^0.5]

@@ -91,9 +91,9 @@ class JIntegral : public Module {
 
  private:
   struct Tip {
-    CrackTip at;               // the pre-crack end, direction and share (crack_tips)
-    long long advances = 0;    // increments it advanced (J criterion; a restart global)
-    double last_advance = 0;   // time of its last advance (J criterion; a restart global)
+    CrackTip at;              // the pre-crack end, direction and share (crack_tips)
+    long long advances = 0;   // increments it advanced (J criterion; a restart global)
+    double last_advance = 0;  // time of its last advance (J criterion; a restart global)
   };
   // Whether tip k's largest contour, centred at `at`, holds another tip of `now`.
   bool holds_other(std::size_t k, const std::vector<std::array<double, 2>>& now) const;

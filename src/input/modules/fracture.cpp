@@ -203,13 +203,12 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
   }
   const auto tips = crack_tips(list, body);
   if (tips.empty())
-    throw InputError("Error, " + what + ": the J-integral's contours surround the crack tips, " +
-                     "the ends of the Discretization->Pre-Cracks entries inside the body (" +
-                     std::to_string(body.lo[0]) + " to " + std::to_string(body.hi[0]) + " m by " +
-                     std::to_string(body.lo[1]) + " to " + std::to_string(body.hi[1]) +
-                     " m); there is " +
-                     (list.empty() ? std::string("no pre-crack") : std::string("no end inside")) +
-                     ".");
+    throw InputError(
+        "Error, " + what + ": the J-integral's contours surround the crack tips, " +
+        "the ends of the Discretization->Pre-Cracks entries inside the body (" +
+        std::to_string(body.lo[0]) + " to " + std::to_string(body.hi[0]) + " m by " +
+        std::to_string(body.lo[1]) + " to " + std::to_string(body.hi[1]) + " m); there is " +
+        (list.empty() ? std::string("no pre-crack") : std::string("no end inside")) + ".");
   // Every tip's contours at the start inside the real body (their edges go to the nearest cell
   // faces, at most dx/2 away; a contour beyond it runs through no material, and J came out 0.012
   // for 0.93 with a half width past the body's faces) and free of the other tips.

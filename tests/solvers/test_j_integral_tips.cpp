@@ -1,0 +1,250 @@
+// The J-integral at every crack tip (include/mupm/solvers/j_integral.hpp): the tips of the
+// pre-cracks, a centre crack's two tips under the J criterion, and Sneddon's pressurised crack.
+//
+// Sneddon: a centre crack of length 2a, a uniform pressure p on its faces, no other load. In an
+// infinite plate K_I = p sqrt(pi a) and J = K_I^2/E' = pi a p^2/E' (E' = E/(1 - nu^2), plane
+// strain). In a strip of width 2b (height 2 x width) by superposition with a remote tension
+// sigma = p: K_I = p sqrt(pi a) F(a/b), F = (1 - 0.025 l^2 + 0.06 l^4) sqrt(sec(pi l/2)),
+// l = a/b (Tada's handbook, within 0.1 %).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mupm/solvers/j_integral.hpp"
+#include "static_plate.hpp"
+#include "test_utils.hpp"
+
+namespace mupm {
+namespace {
+
+using test::cell;
+using test::crack_water_load;
+using test::hold;
+using test::kClassical;
+using test::static_plate;
+using test::StaticPlate;
+using test::tension;
+
+// F(a/b) of a centre crack in a strip of width 2b (header).
+double centre_factor(double l) {
+  return (1 - 0.025 * l * l + 0.06 * std::pow(l, 4)) / std::sqrt(std::cos(M_PI * l / 2));
+}
+
+int rank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+
+JIntegralParams sized(const std::vector<double>& half_spacings, double dx, bool face) {
+  JIntegralParams jp;
+  for (double h : half_spacings)
+    jp.half.push_back({h * dx, h * dx});
+  jp.increment = dx;
+  jp.face = face;
+  return jp;
+}
+
+TEST(JIntegralTips, AreThePreCrackEndsInsideTheBody) {
+  Box body;
+  body.hi[0] = 0.2;
+  body.hi[1] = 0.1;
+  Crack centre, edge, through;
+  centre.a[0] = 0.08, centre.b[0] = 0.12, centre.a[1] = centre.b[1] = 0.05;
+  edge.a[0] = -0.01, edge.b[0] = 0.05, edge.a[1] = edge.b[1] = 0.03;
+  through.a[0] = -0.01, through.b[0] = 0.21, through.a[1] = through.b[1] = 0.07;
+  const auto t = crack_tips({centre, edge, through}, body);
+  ASSERT_EQ(t.size(), 3u);
+  // The centre crack's End, then its Start (growing the other way), each with half of it.
+  EXPECT_EQ(t[0].x[0], 0.12);
+  EXPECT_EQ(t[0].d[0], 1.0);
+  EXPECT_EQ(t[1].x[0], 0.08);
+  EXPECT_EQ(t[1].d[0], -1.0);
+  EXPECT_NEAR(t[0].base, 0.02, 1e-15);
+  EXPECT_NEAR(t[1].base, 0.02, 1e-15);
+  EXPECT_EQ(t[0].crack, 0u);
+  EXPECT_EQ(t[1].crack, 0u);
+  // The edge crack's End, with its length inside the body.
+  EXPECT_EQ(t[2].crack, 1u);
+  EXPECT_EQ(t[2].x[0], 0.05);
+  EXPECT_NEAR(t[2].base, 0.05, 1e-15);
+}
+
+// A centre crack under remote tension, 60 x 60 points: both tips see the same J, the J criterion
+// advances both by its own J, and increments of dx/2 break exactly the bonds one of dx does.
+// The crack's ends sit 0.1 dx off the points where bonds cross its line (multiples of dx/4
+// here): a bond through an end counts as crossing (bond_crosses, core/geometry.hpp), but which
+// side of the end a rounded position falls on differs between the two ends, and J at the tips
+// then differed by 5e-4.
+TEST(JIntegralTips, CentreCrackGrowsAtBothTips) {
+  const int n = 60;
+  const double dx = 1e-3, a = 8.1 * dx;
+  auto P = static_plate(n, n, dx, 3.0, 0.5 * n * dx + a, kClassical, 0.5 * n * dx - a);
+  tension(*P, 1e6);
+  ASSERT_GT(P->sp.solve(1e-13), 0);
+  Damage<2> damage(P->disc, 0.3, MPI_COMM_WORLD);
+  damage.update();
+  JIntegralParams jp = sized({4, 6}, dx, false);
+  jp.criterion = true;
+  jp.increment = 0.5 * dx;
+  JIntegral<2> j(P->disc, jp, damage, MPI_COMM_WORLD);
+  j.attach(P->st, P->sp.prm);
+  ASSERT_EQ(j.tips(), 2u);
+  const double J1 = j.evaluate(0)[0].total, J2 = j.evaluate(1)[0].total;
+  EXPECT_GT(J1, 0);
+  EXPECT_NEAR(J2 / J1, 1.0, 1e-6) << "the tips of a symmetric crack";
+  EXPECT_NEAR(j.evaluate(0)[1].total / J1, 1.0, 0.02) << "path independence";
+  // Two half increments at each tip ...
+  j.attach(P->st, P->sp.prm);
+  auto intact_before =
+      Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), P->disc.bonds.intact);
+  JIntegral<2> low(
+      P->disc,
+      [&] {
+        auto q = jp;
+        q.critical = 0.5 * J1;
+        return q;
+      }(),
+      damage, MPI_COMM_WORLD);
+  low.attach(P->st, P->sp.prm);
+  long long broken = 0;
+  for (int s = 0; s < 2; ++s)
+    broken += low.advance(double(s)).bonds;
+  EXPECT_EQ(low.advances(0), 2);
+  EXPECT_EQ(low.advances(1), 2);
+  EXPECT_DOUBLE_EQ(low.tip(0)[0], 0.5 * n * dx + a + dx);
+  EXPECT_DOUBLE_EQ(low.tip(1)[0], 0.5 * n * dx - a - dx);
+  MPI_Allreduce(MPI_IN_PLACE, &broken, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_GT(broken, 0);
+  SeriesRow row;
+  low.series(row);
+  auto column = [&](const std::string& name) {
+    const auto& v = row.names();
+    const auto it = std::find(v.begin(), v.end(), name);
+    EXPECT_NE(it, v.end()) << name;
+    return it == v.end() ? -1.0 : row.values()[std::size_t(it - v.begin())];
+  };
+  EXPECT_NEAR(column("j_crack_length"), 2 * a + 2 * dx, 1e-15);
+  EXPECT_NEAR(column("j_crack_length_tip1"), a + dx, 1e-15);
+  EXPECT_NEAR(column("j_crack_length_tip2"), a + dx, 1e-15);
+  EXPECT_DOUBLE_EQ(column("j_integral_tip2"), low.evaluate(1)[0].total);
+  EXPECT_DOUBLE_EQ(column("j_integral_tip2_2"), low.evaluate(1)[1].total);
+  GlobalRefs g;
+  low.globals(g);
+  ASSERT_EQ(g.refs().size(), 4u);
+  EXPECT_EQ(g.refs()[2].name, "advances_tip2");
+  // ... break the bonds one increment of dx breaks at each tip.
+  auto after_halves =
+      Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), P->disc.bonds.intact);
+  Kokkos::deep_copy(P->disc.bonds.intact, intact_before);
+  for (double x0 : {0.5 * n * dx + a, 0.5 * n * dx - a - dx}) {
+    Crack seg;
+    seg.a[0] = x0, seg.b[0] = x0 + dx, seg.a[1] = seg.b[1] = 0.5 * P->H;
+    break_crossing<2>(P->disc.points, P->disc.bonds, seg);
+  }
+  auto after_whole = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), P->disc.bonds.intact);
+  long long differ = 0;
+  for (std::size_t b = 0; b < after_whole.extent(0); ++b)
+    differ += after_whole(b) != after_halves(b);
+  EXPECT_EQ(differ, 0);
+}
+
+// Sneddon (header) at a = 16 and 32 spacings, delta = 3 dx, l = a/b = 0.4, the pressure as the
+// row load p/dx on each side of the crack (`water` false) or as the crack water's own force
+// (crack_water_load, the force the step applies, S_rf = 1). Checked: the two tips agree, J with
+// the face term is the same on three contours (the issue asks 2 %), J without it is not (its
+// missing p w(s_Gamma) grows with the contour), and the gap to LEFM closes under refinement.
+// The gap itself is printed, not checked, with the same crack under remote tension beside it
+// (inputs/README.md, "Sneddon's crack"): J sits below LEFM by about 0.88 sqrt(dx/a) with the row
+// load and 0.66 sqrt(dx/a) with the crack water's force, where remote tension gives 1.02 x
+// LEFM: a load that stops at the crack's end leaves the last fraction of a spacing of the
+// lattice's crack unloaded, where the weight function is singular.
+struct Sneddon {
+  double ratio = 0, spread = 0, spread0 = 0, tips = 0;
+};
+
+Sneddon sneddon(int na, bool water, bool remote) {
+  const double dx = 1e-3, l = 0.4, p = 1e6;
+  const int nx = 2 * int(std::lround(na / l)), ny = 2 * nx;
+  const double W = nx * dx, a = na * dx;
+  auto P = static_plate(nx, ny, dx, 3.0, 0.5 * W + a, kClassical, 0.5 * W - a);
+  auto& pts = P->disc.points;
+  pts.applied_crack_force = Vectors("applied_crack_force", pts.size(), 2);
+  if (remote) {
+    tension(*P, p);
+  } else if (water) {
+    crack_water_load(*P, p);
+  } else {
+    for (std::size_t i = 0; i < pts.n_owned; ++i) {
+      const auto c = cell(*P, i);
+      if (std::abs(pts.x(i, 0) - 0.5 * W) < a && (c[1] == ny / 2 || c[1] == ny / 2 - 1)) {
+        const double f = (c[1] == ny / 2 ? 1 : -1) * p / dx;  // pushes the faces apart
+        P->sp.load[i * 3 + 1] = f;
+        pts.applied_crack_force(i, 1) = f;
+      }
+    }
+  }
+  hold(*P);
+  const int its = P->sp.solve();
+  EXPECT_GT(its, 0) << "static solve did not converge";
+  Damage<2> damage(P->disc, 0.3, MPI_COMM_WORLD);
+  damage.update();
+  const std::vector<double> halves = {0.25 * na, 0.4 * na, 0.55 * na};
+  JIntegral<2> j(P->disc, sized(halves, dx, !remote), damage, MPI_COMM_WORLD);
+  j.attach(P->st, P->sp.prm);
+  JIntegral<2> j0(P->disc, sized(halves, dx, false), damage, MPI_COMM_WORLD);
+  j0.attach(P->st, P->sp.prm);
+  EXPECT_EQ(j.tips(), 2u);
+  const double nu = kClassical.poisson(), E1 = kClassical.young() / (1 - nu * nu);
+  const double F = centre_factor(l), lefm = M_PI * a * p * p * F * F / E1;
+  const auto v1 = j.evaluate(0), v2 = j.evaluate(1), c1 = j0.evaluate(0);
+  Sneddon s;
+  double lo = 1e300, hi = -1e300, lo0 = 1e300, hi0 = -1e300;
+  for (std::size_t c = 0; c < v1.size(); ++c) {
+    if (rank() == 0)
+      std::printf(
+          "Sneddon (%s), a = %d dx, delta = 3 dx (%d CG iterations), contour %zu (half %.1f "
+          "dx): J = %.5g at tip 1, %.5g at tip 2 (face term %.4g), without the face term %.5g; "
+          "LEFM %.5g: J/LEFM %.4f (without %.4f); onset of a pressure ramp / LEFM's %.4f\n",
+          remote  ? "remote tension"
+          : water ? "crack water's force"
+                  : "row load",
+          na, its, c + 1, halves[c], v1[c].total, v2[c].total, v1[c].face, c1[c].total, lefm,
+          v1[c].total / lefm, c1[c].total / lefm, 1 / std::sqrt(v1[c].total / lefm));
+    lo = std::min(lo, v1[c].total);
+    hi = std::max(hi, v1[c].total);
+    lo0 = std::min(lo0, c1[c].total);
+    hi0 = std::max(hi0, c1[c].total);
+    s.tips = std::max(s.tips, std::abs(v2[c].total / v1[c].total - 1));
+  }
+  s.ratio = v1[0].total / lefm;
+  s.spread = (hi - lo) / hi;
+  s.spread0 = (hi0 - lo0) / hi;
+  return s;
+}
+
+class JIntegralTipsLong : public ::testing::TestWithParam<bool> {};
+
+TEST_P(JIntegralTipsLong, SneddonClosesUnderRefinement) {
+  const bool water = GetParam();
+  const Sneddon coarse = sneddon(16, water, false), fine = sneddon(32, water, false);
+  for (const Sneddon& s : {coarse, fine}) {
+    EXPECT_LT(s.tips, 1e-4) << "the two tips";
+    EXPECT_LT(s.spread, 0.02) << "path independence with the face term";
+    EXPECT_GT(s.spread0, 0.10) << "the contour term alone depends on the contour";
+  }
+  // Measured 0.72 (row load): the gap falls like sqrt(dx/a), 0.71.
+  EXPECT_LT((1 - fine.ratio) / (1 - coarse.ratio), 0.8) << "the gap to LEFM closes";
+  if (!water)  // the reference: the same crack under remote tension (no face term)
+    sneddon(16, false, true);
+}
+
+INSTANTIATE_TEST_SUITE_P(JStatic, JIntegralTipsLong, ::testing::Bool());
+
+}  // namespace
+}  // namespace mupm
