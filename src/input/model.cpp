@@ -449,6 +449,7 @@ Model<Dim> model_from_input(const ParameterList& input) {
     m.j_integral.half.push_back({widths[k] * unit, heights[k] * unit});
   m.j_integral.criterion = m.fracture.criterion == BondBreaking::JIntegral;
   m.j_integral.face = m.fracture.flow && m.fracture.face_pressure;
+  m.j_integral.cut = m.j_integral.criterion && m.fracture.flow;
   m.j_integral.critical = fracture.get<double>("Critical Energy Release Rate");
   const double inc = j.get<double>("Crack Increment");
   m.j_integral.increment = inc > 0 ? inc : m.grid.dx;

@@ -184,7 +184,23 @@ Breakage JIntegral<Dim>::advance(double time) {
     br.bonds += break_crossing<Dim>(disc_.points, disc_.bonds, seg);
     tp.advances += 1;
   }
+  mark_cuts();
   return br;
+}
+
+template <int Dim>
+void JIntegral<Dim>::mark_cuts() {
+  if (!prm_.cut)
+    return;
+  for (Tip& tp : tips_)
+    for (; tp.marked < tp.advances; ++tp.marked) {
+      Crack seg;
+      for (int a = 0; a < 2; ++a) {
+        seg.a[a] = tp.at.x[a] + double(tp.marked) * prm_.increment * tp.at.d[a];
+        seg.b[a] = seg.a[a] + prm_.increment * tp.at.d[a];
+      }
+      mark_cut<Dim>(disc_.points, seg, disc_.grid.dx);
+    }
 }
 
 template class JIntegral<2>;

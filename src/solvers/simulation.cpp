@@ -76,6 +76,8 @@ RunSummary run(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, Teuchos::Para
     if (rank == 0)
       out << "mupm: restarted from " << run.restart_from << " at step " << step << "\n";
   }
+  if (ph.j_integral)  // a restart's increments: their points are fracture points (kFlagCut)
+    ph.j_integral->mark_cuts();
   ph.damage->update();
   disc.dist.refresh(pts.double_fields(kGhosted));
   ph.damage->update_aperture();

@@ -30,6 +30,38 @@ inline double sent_factor(double aw) {
 inline const MicropolarElastic kClassical =
     MicropolarElastic::from_bulk_shear(60e9, 27.7e9, 27.7e9 * 1e-4, 1e-5);
 
+// The LEFM near-tip (Williams) displacement field of a mode I or II crack along -x from (xt, yt)
+// (test_j_integral.cpp's header), and its rotation.
+struct KField {
+  double K = 1e6;  // stress-intensity factor [Pa m^0.5]
+  bool mode2 = false;
+  double mu = 0, kappa = 0;  // shear modulus, Kolosov's constant
+  double xt = 0, yt = 0;     // tip
+  void u(double x, double y, double* out) const {
+    const double dx = x - xt, dy = y - yt;
+    const double r = std::sqrt(dx * dx + dy * dy), t = std::atan2(dy, dx);
+    const double a = K / (2 * mu) * std::sqrt(r / (2 * M_PI));
+    const double s = std::sin(t / 2), c = std::cos(t / 2);
+    if (!mode2) {
+      out[0] = a * c * (kappa - 1 + 2 * s * s);
+      out[1] = a * s * (kappa + 1 - 2 * c * c);
+    } else {
+      out[0] = a * s * (kappa + 1 + 2 * c * c);
+      out[1] = -a * c * (kappa - 1 - 2 * s * s);
+    }
+  }
+  // (du_y/dx - du_x/dy)/2 by central differences of the closed form.
+  double rotation(double x, double y) const {
+    const double h = 1e-8;
+    double a[2], b[2], c[2], d[2];
+    u(x + h, y, a);
+    u(x - h, y, b);
+    u(x, y + h, c);
+    u(x, y - h, d);
+    return 0.5 * ((a[1] - b[1]) - (c[0] - d[0])) / (2 * h);
+  }
+};
+
 // An edge-cracked plate solved for its static equilibrium (tests/solvers/static_solve.hpp):
 // nx x ny points of spacing dx, horizon factor m, the crack from the left face (or from x =
 // start: a centre crack) to x = a along y = H/2 (a cell face).

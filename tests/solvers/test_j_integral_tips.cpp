@@ -35,12 +35,6 @@ double centre_factor(double l) {
   return (1 - 0.025 * l * l + 0.06 * std::pow(l, 4)) / std::sqrt(std::cos(M_PI * l / 2));
 }
 
-int rank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-
 JIntegralParams sized(const std::vector<double>& half_spacings, double dx, bool face) {
   JIntegralParams jp;
   for (double h : half_spacings)
@@ -206,7 +200,7 @@ Sneddon sneddon(int na, bool water, bool remote) {
   Sneddon s;
   double lo = 1e300, hi = -1e300, lo0 = 1e300, hi0 = -1e300;
   for (std::size_t c = 0; c < v1.size(); ++c) {
-    if (rank() == 0)
+    if (test::world()->getRank() == 0)
       std::printf(
           "Sneddon (%s), a = %d dx, delta = 3 dx (%d CG iterations), contour %zu (half %.1f "
           "dx): J = %.5g at tip 1, %.5g at tip 2 (face term %.4g), without the face term %.5g; "

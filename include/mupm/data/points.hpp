@@ -27,6 +27,9 @@ enum PointFlag : std::uint32_t {
   kFlagPreCrack = 1u << 1,       // adjacent to an initial crack
   // Face of the boundary layer the point belongs to: bit kFlagLayerFace0 << (2*axis + side).
   kFlagLayerFace0 = 1u << 2,
+  // Next to an increment of the J criterion with fracture flow (bits 2-7 are the layer faces):
+  // a fracture point at once, as a pre-crack's neighbour (include/mupm/solvers/j_integral.hpp).
+  kFlagCut = 1u << 8,
 };
 
 // Bit of Points::fixed marking a prescribed pore pressure (bits 0..Dim+RotDim-1: u and theta).

@@ -1,12 +1,14 @@
 // Damage of a point from its bonds (paper eq 37):
 // D_i = 1 - sum_j rho_ij omega V_j / sum_j omega V_j over the family, rho_ij = 1 for an intact
 // bond and 0 for a broken one, omega = 1; and the fracture points (eq 104): D_i >= D_cr, or next
-// to a pre-crack. Kernels only.
+// to a pre-crack or to an increment of the J criterion with fracture flow (kFlagCut). Kernels
+// only.
 #ifndef MUPM_DAMAGE_HPP
 #define MUPM_DAMAGE_HPP
 
 #include <cmath>
 
+#include "mupm/core/geometry.hpp"
 #include "mupm/data/bonds.hpp"
 #include "mupm/data/points.hpp"
 
@@ -55,7 +57,23 @@ void compute_damage(const Bonds& bonds, const Points<Dim>& p, double critical_da
         }
         const double d = all > 0 ? 1.0 - kept / all : 0.0;
         damage(i) = d;
-        fracture(i) = (flags(i) & kFlagPreCrack) || d >= critical_damage ? 1 : 0;
+        fracture(i) = (flags(i) & (kFlagPreCrack | kFlagCut)) || d >= critical_damage ? 1 : 0;
+      });
+}
+
+// Flags the points within dx of `seg` (a 2D segment: the pre-crack's rule, mesh/grid.hpp) with
+// kFlagCut, owned and ghosts.
+template <int Dim>
+void mark_cut(const Points<Dim>& p, const Crack& seg, double dx) {
+  auto x = p.x;
+  auto flags = p.flags;
+  Kokkos::parallel_for(
+      "mupm::Fracture::mark_cut", range(0, p.size()), KOKKOS_LAMBDA(const std::size_t i) {
+        double xi[3] = {0, 0, 0};
+        for (int d = 0; d < Dim; ++d)
+          xi[d] = x(i, d);
+        if (distance2_to_crack<Dim>(seg, xi) < dx * dx)
+          flags(i) |= kFlagCut;
       });
 }
 

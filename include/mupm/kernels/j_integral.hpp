@@ -85,6 +85,7 @@ struct JIntegralParams {
   double increment = 0;                     // Delta a [m]
   double max_speed = 0;                     // the tip's speed cap c_R [m/s] (0: none)
   bool face = false;  // the crack water's face term (Fracture Flow with Face Pressure; header)
+  bool cut = false;   // an increment's points become fracture points (criterion, Fracture Flow)
 };
 
 // A crack tip of the J-integral: an end of a pre-crack (2D segment Start -> End) that lies

@@ -18,6 +18,10 @@
 // tip (the next step's J sees the new tip and the new bond set). A tip outside the real body
 // (the crack ran through) stays, and so does a tip whose largest contour now holds another tip
 // (two cracks meeting: J would be that of both; the input check refuses it at the start).
+// With fracture flow the points within dx of an increment become fracture points at once
+// (kFlagCut, kernels/damage.hpp: the pre-crack's rule), so that the network reaches the tip the
+// criterion grew instead of waiting until their damage reaches D_cr; the flags follow from the
+// advances, so a restart sets them again (mark_cuts).
 // Speed cap (not in the paper's Algorithm 3): after an advance the tip's next waits
 // Delta a / c_R, c_R the skeleton's Rayleigh wave speed, the limit of a running mode I crack's
 // speed. Without it the crack runs at Delta a / dt (above the wave speeds) for as long as the
@@ -89,11 +93,16 @@ class JIntegral : public Module {
   Breakage advance(double time);
   long long advances(std::size_t k = 0) const { return tips_[k].advances; }
 
+  // Flags the points next to the increments not flagged yet (header; with JIntegralParams::cut).
+  // advance() calls it; the driver after a restart, before the damage is computed.
+  void mark_cuts();
+
  private:
   struct Tip {
     CrackTip at;              // the pre-crack end, direction and share (crack_tips)
     long long advances = 0;   // increments it advanced (J criterion; a restart global)
     double last_advance = 0;  // time of its last advance (J criterion; a restart global)
+    long long marked = 0;     // increments whose points mark_cuts flagged
   };
   // Whether tip k's largest contour, centred at `at`, holds another tip of `now`.
   bool holds_other(std::size_t k, const std::vector<std::array<double, 2>>& now) const;
