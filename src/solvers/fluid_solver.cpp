@@ -67,6 +67,7 @@ void FluidSolver<Dim>::globals(GlobalRefs& g) {
     g("fracture_dissipation", fe.dissipation);
     g("fracture_external_work", fe.external_work);
     g("fracture_exchange_work", fe.exchange_work);
+    g("fracture_joined", fracture_->joined());
   }
 }
 
@@ -93,6 +94,8 @@ void FluidSolver<Dim>::series(SeriesRow& row) const {
       row("fluid_inflow_" + fracture_->conditions()[k].name, fracture_->inflows()[k]);
       supplied += fracture_->inflows()[k];
     }
+    row("fracture_fluid_joined", fracture_->joined());
+    supplied += fracture_->joined();
     const auto& fe = fracture_->energy();  // include/mupm/solvers/fracture_flow.hpp header
     row("fracture_fluid_stored_energy", fe.stored);
     row("fracture_fluid_skeleton_work", fe.skeleton_work);

@@ -427,10 +427,12 @@ void FractureFlow<Dim>::scatter(double dt, const Scalars& sink) {
   }
   disc_.dist.refresh({as_vectors(p.pf), as_vectors(p.pf_saturation)});
   const double inv_kw = 1.0 / fluid_.bulk_modulus;
-  // This step's energy terms (header), then the reservoirs' supply per condition.
-  std::vector<double> sums(5 + bcs_.size(), 0.0);
+  // This step's energy terms (header), the water of the points that joined, then the
+  // reservoirs' supply per condition.
+  std::vector<double> sums(6 + bcs_.size(), 0.0);
   double* de = sums.data();
-  double* supplied = sums.data() + 5;
+  double& joined = sums[5];
+  double* supplied = sums.data() + 6;
   for (std::size_t k = 0; k < n; ++k) {
     const Node& nd = net_[k];
     const LocalId i = nd.i;
@@ -455,6 +457,11 @@ void FractureFlow<Dim>::scatter(double dt, const Scalars& sink) {
       de[3] += pm * (stored - gain);
       gain = stored;
     }
+    if (nd.fresh) {  // the crack's volume at joining, filled at p_f^n (header)
+      const double w = vg.saturation(pold) * phi_f_[k];
+      gain += v * w;
+      joined += v * w;
+    }
     p.pf_rate(i) = (x_[k] - pold) / dt;
     p.pf_content(i) += gain / v;
     if (!implicit_)
@@ -472,6 +479,7 @@ void FractureFlow<Dim>::scatter(double dt, const Scalars& sink) {
   energy_.dissipation += de[2];
   energy_.external_work += de[3];
   energy_.exchange_work += de[4];
+  joined_ += fluid_.water_density * joined;
   for (std::size_t c = 0; c < bcs_.size(); ++c)
     inflow_[c] += fluid_.water_density * supplied[c];
 }

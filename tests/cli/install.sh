@@ -11,7 +11,7 @@ cmake --install "$BUILD" --prefix "$WORK/prefix" >install.log || fail "cmake --i
 for f in bin/mupm lib/libmupm.a include/mupm/solvers/simulation.hpp include/mupm/core/version.hpp \
   lib/cmake/mupm/mupmConfig.cmake lib/cmake/mupm/mupmConfigVersion.cmake \
   lib/cmake/mupm/mupmTargets.cmake share/mupm/python/mupm_plot.py \
-  share/mupm/python/mupm_compare.py share/mupm/inputs/quickstart.xml share/mupm/inputs/README.md; do
+  share/mupm/python/mupm_compare.py share/mupm/python/mupm_kgd.py share/mupm/inputs/quickstart.xml share/mupm/inputs/README.md; do
   [[ -e prefix/$f ]] || fail "cmake --install did not put $f under the prefix"
 done
 [[ -x prefix/share/mupm/python/mupm_plot.py ]] || fail "mupm_plot.py is not executable"

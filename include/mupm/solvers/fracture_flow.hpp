@@ -76,10 +76,13 @@
 //   dt (sum_j Lambda_ij (p_j - p_i) + Q_i) + X_i,
 // (on a point of prescribed p_f the reservoir supplies V C_f dp minus that, counted as the
 // condition's inflow). Summed over the network the bond flows cancel pair by pair, so
-// fracture water = injected + exchanged + supplied, to round-off. A point joins the network
-// (becomes a fracture point) with p_f = its bulk p_w, no content and phi_f^n = its phi_f: the
-// crack's volume at joining is taken as filled at that pressure (not booked as water), its
-// opening from then on is.
+// fracture water = injected + exchanged + supplied + joined, to round-off. A point joins the
+// network (becomes a fracture point) with p_f^n = the volume-weighted mean p_f of the network
+// points in its family (the water that reaches it; its bulk p_w where there is none) and
+// phi_f^n = its phi_f: the crack's volume at joining is taken as filled at that pressure, and
+// that water, V S_rf(p_f^n) phi_f, is booked as joined (joined(), the time series'
+// fracture_fluid_joined: a source of the balance, as the crack's volume appeared at once); its
+// opening from then on is booked as the content equation says.
 //
 // Energy of the crack water (issue 9 item 5; the fracture's analogue of eqs 147-149). Multiplying
 // each point's content equation above by the step's mean pressure p_m = (p_i^n + p_i)/2 and
@@ -99,7 +102,8 @@
 // round-off for saturated crack water (C_f = phi_f / K_w constant over the step: psi's change is
 // then exactly C_f (p - p^n) p_m), as the water mass is; it checks the bookkeeping and the
 // linear solve, and for unsaturated crack water measures the step's linearization of C_f (taken
-// at p^n). The crack's volume at joining is not booked (as its water is not). The stored term is
+// at p^n). The energy of the water that fills the crack's volume at joining is not booked (its
+// mass is, above). The stored term is
 // sum V phi_f d(psi), not d(sum V phi_f psi): the energy psi dphi_f that the water filling an
 // opening's new space carries (p^2 / (2 K_w) per unit volume when saturated, p / (2 K_w) of the
 // skeleton work p dphi_f: 5e-4 at 2 MPa) is left out, as the content equation does. D, the
@@ -147,6 +151,9 @@ class FractureFlow {
   // Names of the conditions, with the water [kg] that entered through each so far.
   const std::vector<BoundaryCondition>& conditions() const { return bcs_; }
   std::vector<double>& inflows() { return inflow_; }
+  // The water the points brought that joined the network [kg] (header; a restart global).
+  double& joined() { return joined_; }
+  double joined() const { return joined_; }
   const std::vector<double>& inflows() const { return inflow_; }
   long long network_size() const { return last_size_; }
   // GMRES iterations of the last solve (0 without a network), for the benchmarks.
@@ -231,7 +238,7 @@ class FractureFlow {
       nd.C = C(i);
       nd.G = g0 * p.rel_perm(i);
       nd.bulk_fixed = (p.fixed(i) & kFixedPressure) != 0;
-      nd.pold = nd.fresh ? p.p(i) : p.pf(i);
+      nd.pold = nd.fresh ? joining_pressure(i) : p.pf(i);
       int held = -1;  // later conditions win
       for (std::size_t k = 0; k < bcs_.size(); ++k)
         if (bcs_[k].kind == BoundaryCondition::FracturePressure && in(bcs_[k], i))
@@ -242,6 +249,23 @@ class FractureFlow {
       net_.push_back(nd);
     }
     disc_.dist.refresh({shared_});
+  }
+
+  // p_f^n of a point that joins the network now (header): the volume-weighted mean p_f of the
+  // network points in its family (p_f and S_rf current on the ghosts since the last scatter),
+  // or its bulk p_w where none is.
+  double joining_pressure(std::size_t i) const {
+    const auto& p = disc_.points;
+    const auto& b = disc_.bonds;
+    double sum = 0, vol = 0;
+    for (BondIndex e = b.offsets(i); e < b.offsets(i + 1); ++e) {
+      const LocalId j = b.neighbor(e);
+      if (p.pf_saturation(j) > 0) {
+        sum += p.volume(j) * p.pf(j);
+        vol += p.volume(j);
+      }
+    }
+    return vol > 0 ? sum / vol : p.p(i);
   }
 
   // collect(), then the network's size over the ranks: false (on every rank) when it is empty,
@@ -278,6 +302,7 @@ class FractureFlow {
   LinearSolve solver_;
   std::vector<BoundaryCondition> bcs_;
   std::vector<double> inflow_;
+  double joined_ = 0;  // joined() [kg]
   Vectors shared_;   // [points][3]: on the network, held condition + 1, p_f^n (collect)
   Vectors coupled_;  // [points][2]: conductance kappa, start value x0 (assemble)
   // The owned network points and their rows.
