@@ -102,6 +102,7 @@ TEST(JIntegralTips, CentreCrackGrowsAtBothTips) {
       [&] {
         auto q = jp;
         q.critical = 0.5 * J1;
+        q.cut = true;  // as with fracture flow
         return q;
       }(),
       damage, MPI_COMM_WORLD);
@@ -132,6 +133,44 @@ TEST(JIntegralTips, CentreCrackGrowsAtBothTips) {
   low.globals(g);
   ASSERT_EQ(g.refs().size(), 4u);
   EXPECT_EQ(g.refs()[2].name, "advances_tip2");
+  // The points next to the increments are fracture points at once (kFlagCut): the row on each
+  // side of the crack over the grown dx and the cell ahead of each new tip, whose damage is
+  // below D_cr.
+  auto& pts = P->disc.points;
+  damage.update();
+  int cut = 0, below = 0;
+  for (std::size_t i = 0; i < pts.n_owned; ++i) {
+    const double s = std::abs(pts.x(i, 0) - 0.5 * n * dx) / dx, y = pts.x(i, 1) - 0.5 * P->H;
+    if (std::abs(std::abs(y) - 0.5 * dx) < 1e-9 && (std::abs(s - 8.5) < 1e-6 || std::abs(s - 9.5) < 1e-6)) {
+      ++cut;
+      EXPECT_TRUE(pts.fracture(i)) << "x = " << pts.x(i, 0) << ", y = " << pts.x(i, 1);
+      below += pts.damage(i) < 0.3;
+    }
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &below, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(cut, 8);
+  EXPECT_GT(below, 0) << "the flag, not the damage, made them fracture points";
+  // A restart: the flags follow from the advances alone.
+  auto flags = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pts.flags);
+  Kokkos::parallel_for(
+      "test::clear_cut", range(0, pts.size()),
+      KOKKOS_LAMBDA(const std::size_t i) { pts.flags(i) &= ~std::uint32_t(kFlagCut); });
+  JIntegral<2> again(P->disc, [&] {
+    auto q = jp;
+    q.cut = true;
+    return q;
+  }(), damage, MPI_COMM_WORLD);
+  GlobalRefs h;
+  again.globals(h);
+  for (std::size_t k = 0; k < h.refs().size(); ++k)
+    h.refs()[k].set(g.refs()[k].get());
+  again.mark_cuts();
+  auto remarked = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pts.flags);
+  long long flags_differ = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    flags_differ += flags(i) != remarked(i);
+  EXPECT_EQ(flags_differ, 0);
   // ... break the bonds one increment of dx breaks at each tip.
   auto after_halves =
       Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), P->disc.bonds.intact);
