@@ -62,8 +62,8 @@ struct Slot {
   }
 };
 
-inline BoundaryCondition condition(BoundaryCondition::Kind kind, const std::string& name, int region,
-                            double value) {
+inline BoundaryCondition condition(BoundaryCondition::Kind kind, const std::string& name,
+                                   int region, double value) {
   BoundaryCondition bc;
   bc.kind = kind;
   bc.name = name;

@@ -707,8 +707,8 @@ TEST(FractureFlowSemiImplicit, IncompressibleCrackOpensByTheInjectedVolume) {
         "semi-implicit crack: dt %.3e s; crack volume %.9e m^3, injected %.9e m^3 (ratio "
         "%.10f); water error %.2e kg; crack water balance %.2e J of %.2e J; solid %.2e J of "
         "%.2e J\n",
-        dt, crack, injected, crack / injected, water - water0 - ff->inflows()[0] - ff->joined(), fe.balance(),
-        fe.scale(), e.balance(), e.scale());
+        dt, crack, injected, crack / injected, water - water0 - ff->inflows()[0] - ff->joined(),
+        fe.balance(), fe.scale(), e.balance(), e.scale());
   EXPECT_NEAR(injected, expected, 1e-12 * expected);
   EXPECT_GT(crack, 0.0);
   EXPECT_NEAR(crack / injected, 1.0, 1e-6);
@@ -783,8 +783,8 @@ TEST(FractureFlowSemiImplicit, CrackWaterBalanceHoldsThroughBreakage) {
         "semi-implicit crack through breakage: %lld pairs broken in %d steps of %.3e s; crack "
         "water balance at most %.2e of its scale; water error %.2e kg of %.3e kg; solid balance "
         "%.2e of its scale after the first breakage step, at most %.2e\n",
-        solid.broken_pairs() - broken0, n, dt, worst, water - water0 - ff->inflows()[0] - ff->joined(), water0,
-        solid_first, solid_worst);
+        solid.broken_pairs() - broken0, n, dt, worst,
+        water - water0 - ff->inflows()[0] - ff->joined(), water0, solid_first, solid_worst);
   EXPECT_GT(solid.broken_pairs(), broken0);  // the tip broke
   EXPECT_LT(worst, 1e-10);
   EXPECT_LT(std::abs(water - water0 - ff->inflows()[0] - ff->joined()), 1e-12 * water0);

@@ -72,12 +72,12 @@ TEST(FractureJoining, AtTheNetworkPressureWithItsWaterBooked) {
   const double would = rho * fill * p1 / prm.bulk_modulus;
   const double worst =
       sum_owned(p, [&](std::size_t i) { return on(i) ? std::abs(p.pf(i) - p1) / p1 : 0.0; });
-  const double water =
-      fluid.fluid_mass() + ff->mass() - mass0 - ff->inflows()[0] - ff->joined();
+  const double water = fluid.fluid_mass() + ff->mass() - mass0 - ff->inflows()[0] - ff->joined();
   if (test::world()->getRank() == 0)
-    std::printf("joining: %g points, joined %.9e kg (closed form %.9e), the held end supplied "
-                "%.3e kg in the step (%.3e kg joining at p_w); p_f off p1 by %.2e; water %.2e kg\n",
-                joining, joined, rho * fill, supplied, would, worst, water);
+    std::printf(
+        "joining: %g points, joined %.9e kg (closed form %.9e), the held end supplied "
+        "%.3e kg in the step (%.3e kg joining at p_w); p_f off p1 by %.2e; water %.2e kg\n",
+        joining, joined, rho * fill, supplied, would, worst, water);
   EXPECT_NEAR(joined, rho * fill, 1e-12 * rho * fill);
   EXPECT_LT(std::abs(supplied), 1e-6 * would);
   EXPECT_LT(worst, 1e-9);

@@ -141,7 +141,8 @@ TEST(JIntegralTips, CentreCrackGrowsAtBothTips) {
   int cut = 0, below = 0;
   for (std::size_t i = 0; i < pts.n_owned; ++i) {
     const double s = std::abs(pts.x(i, 0) - 0.5 * n * dx) / dx, y = pts.x(i, 1) - 0.5 * P->H;
-    if (std::abs(std::abs(y) - 0.5 * dx) < 1e-9 && (std::abs(s - 8.5) < 1e-6 || std::abs(s - 9.5) < 1e-6)) {
+    if (std::abs(std::abs(y) - 0.5 * dx) < 1e-9 &&
+        (std::abs(s - 8.5) < 1e-6 || std::abs(s - 9.5) < 1e-6)) {
       ++cut;
       EXPECT_TRUE(pts.fracture(i)) << "x = " << pts.x(i, 0) << ", y = " << pts.x(i, 1);
       below += pts.damage(i) < 0.3;
@@ -156,11 +157,14 @@ TEST(JIntegralTips, CentreCrackGrowsAtBothTips) {
   Kokkos::parallel_for(
       "test::clear_cut", range(0, pts.size()),
       KOKKOS_LAMBDA(const std::size_t i) { pts.flags(i) &= ~std::uint32_t(kFlagCut); });
-  JIntegral<2> again(P->disc, [&] {
-    auto q = jp;
-    q.cut = true;
-    return q;
-  }(), damage, MPI_COMM_WORLD);
+  JIntegral<2> again(
+      P->disc,
+      [&] {
+        auto q = jp;
+        q.cut = true;
+        return q;
+      }(),
+      damage, MPI_COMM_WORLD);
   GlobalRefs h;
   again.globals(h);
   for (std::size_t k = 0; k < h.refs().size(); ++k)

@@ -303,8 +303,8 @@ class FractureFlow {
   std::vector<BoundaryCondition> bcs_;
   std::vector<double> inflow_;
   double joined_ = 0;  // joined() [kg]
-  Vectors shared_;   // [points][3]: on the network, held condition + 1, p_f^n (collect)
-  Vectors coupled_;  // [points][2]: conductance kappa, start value x0 (assemble)
+  Vectors shared_;     // [points][3]: on the network, held condition + 1, p_f^n (collect)
+  Vectors coupled_;    // [points][2]: conductance kappa, start value x0 (assemble)
   // The owned network points and their rows.
   std::vector<Node> net_;
   std::vector<std::size_t> adj_first_;

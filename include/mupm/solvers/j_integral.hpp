@@ -16,7 +16,7 @@
 // increment: the intact bonds that cross the segment tip -> tip + Delta a d break (both copies:
 // the test is on reference positions, the same on every rank), at most one increment a step per
 // tip (the next step's J sees the new tip and the new bond set). A tip outside the real body
-// (the crack ran through) stays, and so does a tip whose largest contour now holds another tip
+// (the crack ran through) stays, and so does a tip whose contours now hold another tip
 // (two cracks meeting: J would be that of both; the input check refuses it at the start).
 // With fracture flow the points within dx of an increment become fracture points at once
 // (kFlagCut, kernels/damage.hpp: the pre-crack's rule), so that the network reaches the tip the
@@ -104,7 +104,7 @@ class JIntegral : public Module {
     double last_advance = 0;  // time of its last advance (J criterion; a restart global)
     long long marked = 0;     // increments whose points mark_cuts flagged
   };
-  // Whether tip k's largest contour, centred at `at`, holds another tip of `now`.
+  // Whether a contour of tip k, centred at now[k], holds another tip of `now`.
   bool holds_other(std::size_t k, const std::vector<std::array<double, 2>>& now) const;
 
   Discretization<Dim>& disc_;
