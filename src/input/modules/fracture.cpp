@@ -180,35 +180,18 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
                          " has a half size of " + std::to_string(v * unit) +
                          " m, below one Spacing (" + std::to_string(dx) +
                          " m): a contour must hold the tip and the points around it.");
-  // The tips (kernels/j_integral.hpp, crack_tips): the pre-crack ends inside the real body.
-  const ParameterList& cracks = d.sublist("Pre-Cracks");
-  std::vector<Crack> list;
-  for (auto it = cracks.begin(); it != cracks.end(); ++it) {
-    const ParameterList& c = cracks.sublist(cracks.name(it));
-    const auto a = c.get<Array<double>>("Start"), b = c.get<Array<double>>("End");
-    Crack cr;
-    for (int k = 0; k < 2; ++k) {
-      cr.a[k] = a[k];
-      cr.b[k] = b[k];
-    }
-    list.push_back(cr);
-  }
-  const auto counts = d.get<Array<int>>("Counts");
-  const auto ext = d.get<Array<double>>("Extents");
-  const auto origin = d.get<Array<double>>("Origin");
-  Box body;
-  for (int a = 0; a < 2; ++a) {
-    body.lo[a] = origin.empty() ? 0.0 : origin[a];
-    body.hi[a] = body.lo[a] + (counts.empty() ? std::round(ext[a] / dx) : double(counts[a])) * dx;
-  }
-  const auto tips = crack_tips(list, body);
+  // The tips (kernels/j_integral.hpp, crack_tips): the pre-crack ends inside the real body of
+  // the grid the run will build (Discretization's check has passed).
+  const GridSpec<2> g = grid_from_input<2>(input);
+  const Box body = g.body();
+  const auto tips = crack_tips(g.cracks, body);
   if (tips.empty())
     throw InputError(
         "Error, " + what + ": the J-integral's contours surround the crack tips, " +
         "the ends of the Discretization->Pre-Cracks entries inside the body (" +
         std::to_string(body.lo[0]) + " to " + std::to_string(body.hi[0]) + " m by " +
         std::to_string(body.lo[1]) + " to " + std::to_string(body.hi[1]) + " m); there is " +
-        (list.empty() ? std::string("no pre-crack") : std::string("no end inside")) + ".");
+        (g.cracks.empty() ? std::string("no pre-crack") : std::string("no end inside")) + ".");
   // Every tip's contours at the start inside the real body (their edges go to the nearest cell
   // faces, at most dx/2 away; a contour beyond it runs through no material, and J came out 0.012
   // for 0.93 with a half width past the body's faces) and free of the other tips.
