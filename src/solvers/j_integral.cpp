@@ -85,12 +85,20 @@ JContours JIntegral<Dim>::contours(const std::array<double, 2>& at, std::size_t 
     jc.body.lo[a] = g.origin[a] - g.layers[a][0] * g.dx;
     jc.body.hi[a] = g.origin[a] + double(g.counts[a] + g.layers[a][1]) * g.dx;
   }
-  for (int c = 0; c < jc.count; ++c)
-    for (int a = 0; a < 2; ++a) {  // the tip to a face first, so that the box is centred on it
-      const double t = face(a, at[a]), h = std::round(prm_.half[c][a] / g.dx) * g.dx;
-      jc.box[c].lo[a] = t - h;
-      jc.box[c].hi[a] = t + h;
+  // The face term's cut (kernels/j_integral.hpp): one spacing beyond the horizon's rows behind
+  // the tip, nearer on a contour that does not reach so far.
+  const double cut = double(g.horizon_cells() + 1) * g.dx;
+  for (int a = 0; a < 2; ++a)  // the tip to a face first, so that the boxes are centred on it
+    jc.tip[a] = face(a, at[a]);
+  for (int c = 0; c < jc.count; ++c) {
+    double h[2];
+    for (int a = 0; a < 2; ++a) {
+      h[a] = std::round(prm_.half[c][a] / g.dx) * g.dx;
+      jc.box[c].lo[a] = jc.tip[a] - h[a];
+      jc.box[c].hi[a] = jc.tip[a] + h[a];
     }
+    jc.cut[c] = std::min(cut, std::min(h[0], h[1]));
+  }
   return jc;
 }
 
