@@ -88,8 +88,12 @@ JContours JIntegral<Dim>::contours(const std::array<double, 2>& at, std::size_t 
   // The face term's cut (kernels/j_integral.hpp): one spacing beyond the horizon's rows behind
   // the tip, nearer on a contour that does not reach so far.
   const double cut = double(g.horizon_cells() + 1) * g.dx;
-  for (int a = 0; a < 2; ++a)  // the tip to a face first, so that the boxes are centred on it
-    jc.tip[a] = face(a, at[a]);
+  // The tip to a face first, so that the boxes are centred on it; a tip at a cell centre (after
+  // an odd number of increments of dx/2) to the face ahead of it along d, alike for every tip
+  // (rounding the position alone sent the two tips of a centre crack to opposite sides: their
+  // J differed by 8 % after the first increment, and the tips grew apart).
+  for (int a = 0; a < 2; ++a)
+    jc.tip[a] = face(a, at[a] + 0.25 * g.dx * jc.d[a]);
   for (int c = 0; c < jc.count; ++c) {
     double h[2];
     for (int a = 0; a < 2; ++a) {

@@ -9,7 +9,8 @@
 // Delta a along d (n_k kept across a restart); otherwise it is the farthest fracture point
 // beyond the end along d (Damage::farthest), or the end before growth. Each contour is centred
 // on its tip with the given half width (along x) and half height, its edges moved to the
-// nearest cell faces; the contours move with the tip.
+// nearest cell faces (a tip at a cell centre counts as the face ahead of it along d); the
+// contours move with the tip.
 //
 // The J criterion (Algorithm 3), tip by tip and each by its own J: after the solid's step (its
 // forces of the new state), while J/h of a tip's first contour >= G_cr that tip advances one
