@@ -91,7 +91,7 @@ JContours JIntegral<Dim>::contours(const std::array<double, 2>& at, std::size_t 
   // The tip to a face first, so that the boxes are centred on it; a tip at a cell centre (after
   // an odd number of increments of dx/2) to the face ahead of it along d, alike for every tip
   // (rounding the position alone sent the two tips of a centre crack to opposite sides: their
-  // J differed by 8 % after the first increment, and the tips grew apart).
+  // J differed by 8 % after the KGD's first increment).
   for (int a = 0; a < 2; ++a)
     jc.tip[a] = face(a, at[a] + 0.25 * g.dx * jc.d[a]);
   for (int c = 0; c < jc.count; ++c) {

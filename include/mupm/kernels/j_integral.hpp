@@ -53,8 +53,7 @@
 // the water as force densities on the fracture points (Points::applied_crack_force, the ones the
 // step applied), so the face term is a sum over the points in B1, split at a cut, a line across
 // the crack at the distance r_c behind the tip (s the distance behind the tip along d):
-//   J_face = - sum_{i in B1, s_i > r_c} b_i.u_1(i) V_i + sum_{|s_i - r_c| = dx/2} b_i.u_i V_i/(2
-//   dx).
+//   J_face = - sum_{s_i > r_c} b_i.u_1(i) V_i + sum_{|s_i - r_c| = dx/2} b_i.u_i V_i / (2 dx).
 // Behind the cut the field is smooth and the point's u_1 (its nonlocal gradient, one-sided at a
 // face) makes the sum path-independent. Between the tip and the cut the load is taken as
 // uniform along d, t(s) = t(r_c) on each line parallel to d, so that its integral is exact:
@@ -71,7 +70,7 @@
 // pressure that varies on the crack's scale. r_c is one spacing beyond the horizon's rows
 // ((floor(delta/dx) + 1) dx: the gradients behind it do not reach the tip's last cell), or a
 // contour's half size when that is smaller; both on cell faces, the contours being centred on the
-// tip placed on the nearest cell faces (solvers/j_integral.cpp).
+// tip placed on cell faces (solvers/j_integral.cpp).
 // With Crack Water Force = Eq 17 (the water on the bonds) the face term is left out.
 //
 // Left out, as in the paper's J: kinetic energy (J is that of a static field; in a running crack
