@@ -191,6 +191,7 @@ void j_integral_terms_variant(const Points<2>& pts, const Bonds& bonds, const So
         double gi[2], hi;
         derivs(int(i), gi, hi);
         const double Wi = energy(i) / vol(i);
+        const double si = c.tip_s(xi_);  // the distance behind the tip (the face term's cut)
         for (int ci = 0; ci < c.count; ++ci) {
           const Box& b = c.box[ci];
           double w = 0, tr = 0, rot = 0, fc = 0;
@@ -216,7 +217,7 @@ void j_integral_terms_variant(const Points<2>& pts, const Bonds& bonds, const So
           }
           // Bond terms: i in B1 (inside), j in B2 (outside); the face term of i in B1.
           if (in_box<Dim>(b, xi_, 0.0)) {
-            if (loaded && c.tip_s(xi_) > c.cut[ci] + 0.25 * c.dx)  // behind the cut (header)
+            if (loaded && si > c.cut[ci] + 0.25 * c.dx)  // behind the cut (header)
               fc = -(face(i, 0) * gi[0] + face(i, 1) * gi[1]) * vol(i) / c.thickness;
             for (BondIndex bd = offsets(i); bd < offsets(i + 1); ++bd) {
               if (!intact(bd))
@@ -269,7 +270,7 @@ void j_integral_terms_variant(const Points<2>& pts, const Bonds& bonds, const So
           }
           // The cut's term t.u(r_c): the points at dx/2 either side of the cut whose line
           // parallel to d crosses it inside the box (header).
-          const double sc = c.tip_s(xi_) - c.cut[ci];
+          const double sc = si - c.cut[ci];
           if (loaded && std::abs(sc) < 0.75 * c.dx) {
             const double q[2] = {xi_[0] + (sc + 0.25 * c.dx) * c.d[0],
                                  xi_[1] + (sc + 0.25 * c.dx) * c.d[1]};
