@@ -331,11 +331,11 @@ INSTANTIATE_TEST_SUITE_P(JStatic, JIntegralTipsLong, ::testing::Bool());
 // crack water's force, a = 8.1 dx, l = a/b = 0.14: J of the total force state against LEFM with
 // the undrained E' and against the lattice's compliance G (the solves at a and a + dx). Measured:
 // G / LEFM 0.997; J / G 1.036 on the contour of half 2 dx, 1.011 on 4.5 dx. J's W is the
-// skeleton's energy alone (solid pass 1): the water's p*^2 / (2 M) is left out, which makes J
-// depend on the contour by those 2.5 %. With the drained E' LEFM would be 1.61 times larger: the
-// check fails if the water's coupling is lost. (A skeleton with lambda + M in place of the
-// water is not the same lattice: its stabilization modulus takes lambda + mu, and J and G came
-// out 0.77 of LEFM.)
+// skeleton's energy alone (solid pass 1): the water's p*^2 / (2 M) is left out, the likely
+// source of J's 2.2 % spread over the contours (0.1 % in the dry crack). With the drained E' LEFM
+// would be 1.61 times larger: the check fails if the water's coupling is lost. (A skeleton with
+// lambda + M in place of the water is not the same lattice: its stabilization modulus takes lambda
+// + mu, and J and G came out 0.76-0.79 of LEFM.)
 TEST(JIntegralTipsUndrainedLong, SneddonMatchesUndrainedLefm) {
   SneddonMaterial mat;
   mat.law = MicropolarElastic::from_bulk_shear(270.83e6, 220.33e6, 100e6, 0.4e-3);
