@@ -307,7 +307,7 @@ expect j_no_contour 2 'mupm->Fracture->Bond Breakage' 'mupm->J-Integral->Half Wi
 base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3, 4}"/><Parameter name="Half Heights" type="Array(double)" value="{3}"/>' >j_sizes.xml
 expect j_sizes 2 'mupm->J-Integral->Half Heights' 'one per contour'
 # ... a crack with no end inside the body, a contour that holds the other tip, an increment
-# above one spacing.
+# above one spacing, a crack speed without the J criterion.
 through='<ParameterList name="Pre-Cracks"><ParameterList name="c"><Parameter name="Start" type="Array(double)" value="{-0.01, 0.05}"/><Parameter name="End" type="Array(double)" value="{0.21, 0.05}"/></ParameterList></ParameterList>'
 base "$through" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/>' >j_no_tip.xml
 expect j_no_tip 2 'mupm->J-Integral->Half Widths' 'no end inside'
@@ -317,6 +317,8 @@ expect j_other_tip 2 'mupm->J-Integral->Half Widths' 'contour 2 around tip 1' 'h
 base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/><Parameter name="Crack Increment" type="double" value="0.015"/>' |
   sed 's|  <ParameterList name="Solver">|  <ParameterList name="Fracture"><Parameter name="Bond Breakage" type="string" value="J-Integral"/><Parameter name="Critical Energy Release Rate" type="double" value="10"/></ParameterList>\n&|' >j_increment.xml
 expect j_increment 2 'mupm->J-Integral->Crack Increment' 'exceeds one Spacing'
+base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/><Parameter name="Maximum Crack Speed" type="double" value="10"/>' >j_speed.xml
+expect j_speed 2 'mupm->J-Integral->Maximum Crack Speed' 'Bond Breakage = J-Integral'
 # Drucker-Prager: no cohesion, a residual cohesion above the initial one.
 base '' '' | sed 's|<Parameter name="Bulk Modulus"|<Parameter name="Model" type="string" value="Micropolar Drucker-Prager"/>&|' >dp_no_cohesion.xml
 expect dp_no_cohesion 2 'mupm->Materials->Cohesion' 'must be > 0'

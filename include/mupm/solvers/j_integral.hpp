@@ -27,6 +27,8 @@
 // Delta a / c_R, c_R the skeleton's Rayleigh wave speed, the limit of a running mode I crack's
 // speed. Without it the crack runs at Delta a / dt (above the wave speeds) for as long as the
 // contours, whose edges the field of the last increment has not reached yet, show J >= G_cr.
+// J-Integral->Maximum Crack Speed replaces c_R by a given speed: a quasi-static crack (a
+// hydraulic fracture) waits until the field and the crack water have settled.
 //
 // Sums over ranks: every point's terms are added exactly (include/mupm/core/exact_sum.hpp), so
 // that J, and with it the criterion's decision, is the same to the last bit on any number of

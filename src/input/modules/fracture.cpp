@@ -134,6 +134,12 @@ void declare_j_integral(ParameterList& j) {
         "running mode I crack's limit). false: an advance whenever J/h >= G_cr, at most one a "
         "step (the paper's Algorithm 3), which lets the crack run at Delta a / dt while the "
         "contours still show the field of before the last increment.");
+  j.set("Maximum Crack Speed", 0.0,
+        "J criterion with Speed Cap: the speed v [m/s] in the wait Delta a / v between a tip's "
+        "advances (0: c_R). A crack that should grow quasi-statically (a hydraulic fracture "
+        "against a closed form) takes a v far above its own speed and far below c_R, so that "
+        "the field and the crack water settle after each increment before the next J decision.",
+        at_least(0.0));
 }
 
 // J-Integral: 2D, a solid, a pre-crack, matching contour sizes that fit the body at the start.
@@ -228,6 +234,11 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
                      " m exceeds one Spacing (" + std::to_string(dx) +
                      " m): an increment breaks the bonds across it at once, and one longer "
                      "than a spacing skips the lattice's cells (0: one Spacing).");
+  if (j.get<double>("Maximum Crack Speed") > 0 && !(criterion && j.get<bool>("Speed Cap")))
+    throw InputError("Error, " + path_of(j, "Maximum Crack Speed") +
+                     " is given, but it sets the J criterion's speed cap: it needs " +
+                     path_of(fr, "Bond Breakage") + " = J-Integral and " + path_of(j, "Speed Cap") +
+                     " = true.");
   for (Teuchos::Ordinal k = 0; k < w.size(); ++k)
     if (criterion && std::min(w[k], h[k]) * unit < inc)
       throw InputError("Error, " + path_of(j, "Crack Increment") + " = " + std::to_string(inc) +
