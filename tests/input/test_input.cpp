@@ -2,6 +2,8 @@
 // a valid input gets every default; the grid follows from the parameters.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <Teuchos_Array.hpp>
 
 #include "mupm/input/input.hpp"
@@ -295,6 +297,45 @@ TEST(Input, SolidAndBoundaryConditions) {
   EXPECT_DOUBLE_EQ(bcs[0].time(2.0), 0.5);
   EXPECT_DOUBLE_EQ(bcs[0].time(5.0), 0.0);  // held after the table
   EXPECT_DOUBLE_EQ(bcs[0].time.rate(2.0), -0.5);
+}
+
+// The J criterion's speed cap (J-Integral->Speed Cap, Maximum Crack Speed): by default the
+// skeleton's Rayleigh speed c_R = c_s (0.862 + 1.14 nu) / (1 + nu), c_s = sqrt(mu / rho) (here
+// K = 1e8, mu = 5e7: nu = 0.2857; rho = 2000 kg/m^3, dry); a given speed replaces it; none
+// without the cap; the speed without the J criterion or without the cap is refused.
+TEST(Input, JCriterionSpeedCap) {
+  const std::string grid =
+      kOk +
+      "<ParameterList name=\"Pre-Cracks\"><ParameterList name=\"c\">"
+      "<Parameter name=\"Start\" type=\"Array(double)\" value=\"{-0.01, 0.04}\"/>"
+      "<Parameter name=\"End\" type=\"Array(double)\" value=\"{0.045, 0.04}\"/>"
+      "</ParameterList></ParameterList>";
+  auto input = [&](const std::string& j, bool criterion = true) {
+    return xml(grid,
+               std::string(criterion ? "<ParameterList name=\"Fracture\"><Parameter name=\"Bond "
+                                       "Breakage\" type=\"string\" value=\"J-Integral\"/>"
+                                       "<Parameter name=\"Critical Energy Release Rate\" "
+                                       "type=\"double\" value=\"10\"/></ParameterList>"
+                                     : "") +
+                   "<ParameterList name=\"J-Integral\"><Parameter name=\"Half Widths\" "
+                   "type=\"Array(double)\" value=\"{2}\"/>" +
+                   j + "</ParameterList>");
+  };
+  auto speed = [&](const std::string& j) {
+    auto pl = parse_input(input(j));
+    validate_input(*pl);
+    return model_from_input<2>(*pl).j_integral.max_speed;
+  };
+  const double mu = 5e7, nu = (3 * 1e8 - 2 * mu) / (2 * (3 * 1e8 + mu));
+  const double rho = 2000;  // Materials->Solid Density's default, no pores
+  EXPECT_NEAR(speed(""), std::sqrt(mu / rho) * (0.862 + 1.14 * nu) / (1 + nu), 1e-9);
+  const std::string ten = "<Parameter name=\"Maximum Crack Speed\" type=\"double\" value=\"10\"/>";
+  EXPECT_EQ(speed(ten), 10.0);
+  const std::string off = "<Parameter name=\"Speed Cap\" type=\"bool\" value=\"false\"/>";
+  EXPECT_EQ(speed(off), 0.0);
+  expect_error(input(ten + off), {"mupm->J-Integral->Maximum Crack Speed", "Speed Cap = true"});
+  expect_error(input(ten, false),
+               {"mupm->J-Integral->Maximum Crack Speed", "mupm->Fracture->Bond Breakage"});
 }
 
 // Discretization->Plane = Stress gives the elastic law lambda* = 2 lambda mu / (lambda + 2 mu)
