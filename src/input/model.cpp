@@ -458,10 +458,11 @@ Model<Dim> model_from_input(const ParameterList& input) {
   // the initial mixture density of saturated pores (the heaviest: the lowest speed).
   const double rho = mixture_density(m.porosity, m.solid_density, 1.0, m.fluid.water_density);
   const double nu = m.solid.law.poisson();
-  const double v = j.get<double>("Maximum Crack Speed");
-  if (j.get<bool>("Speed Cap"))
+  if (j.get<bool>("Speed Cap")) {
+    const double v = j.get<double>("Maximum Crack Speed");  // 0: c_R
     m.j_integral.max_speed =
         v > 0 ? v : std::sqrt(m.solid.law.mu / rho) * (0.862 + 1.14 * nu) / (1 + nu);
+  }
 
   m.boundary_conditions = boundary_conditions_from_input(input);
   for (const auto& bc : m.boundary_conditions)

@@ -131,7 +131,8 @@ void declare_j_integral(ParameterList& j) {
   j.set("Speed Cap", true,
         "J criterion: after an advance the next waits Delta a / c_R, c_R = c_s (0.862 + "
         "1.14 nu)/(1 + nu) the skeleton's Rayleigh wave speed at the initial density (a "
-        "running mode I crack's limit). false: an advance whenever J/h >= G_cr, at most one a "
+        "running mode I crack's limit), or Delta a / Maximum Crack Speed when that is given. "
+        "false: an advance whenever J/h >= G_cr, at most one a "
         "step (the paper's Algorithm 3), which lets the crack run at Delta a / dt while the "
         "contours still show the field of before the last increment.");
   j.set("Maximum Crack Speed", 0.0,
