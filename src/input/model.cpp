@@ -463,6 +463,14 @@ Model<Dim> model_from_input(const ParameterList& input) {
     m.j_integral.max_speed =
         v > 0 ? v : std::sqrt(m.solid.law.mu / rho) * (0.862 + 1.14 * nu) / (1 + nu);
   }
+  m.fracture.release_time = j.get<double>("Release Time");  // needs the cap (modules/fracture)
+  const double wait = m.j_integral.increment / m.j_integral.max_speed;
+  if (m.fracture.release_time > wait * (1 + 1e-9))
+    throw InputError("Error, " + input.name() +
+                     "->J-Integral->Release Time = " + std::to_string(m.fracture.release_time) +
+                     " s exceeds the speed cap's wait " + "Delta a / v = " + std::to_string(wait) +
+                     " s (Crack Increment / Maximum Crack Speed, or / c_R): the next J decision "
+                     "would see a field still under release.");
 
   m.boundary_conditions = boundary_conditions_from_input(input);
   for (const auto& bc : m.boundary_conditions)

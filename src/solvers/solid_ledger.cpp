@@ -28,7 +28,8 @@ double SolidEnergy::scale() const {
 }
 
 void SolidLedger::book(const StepTerms& w) {
-  totals_.external_work += w.external_work;
+  totals_.external_work += w.external_work - w.release_work;
+  totals_.fracture -= w.release_work;
   totals_.crack_work += w.crack_work;
   totals_.dissipation += w.dissipation;
   totals_.pore_work += w.pore_work;

@@ -31,6 +31,8 @@ SolidSolver<Dim, Law>::SolidSolver(Discretization<Dim>& disc, const SolidParams&
     p.require(kGroupSecondOrderWork, "SolidSolver's second-order work");
   if (set_.fracture.flow)
     p.require(kGroupCrackWater, "SolidSolver's crack water force");
+  if (releases())
+    p.require(kGroupRelease, "SolidSolver's gradual release");
   st_.allocate(p.size(), p.n_owned);
   rho_ = Scalars("mupm::density", p.n_owned);
   inertia_ = Scalars("mupm::micro_inertia", p.n_owned);
@@ -62,6 +64,8 @@ void SolidSolver<Dim, Law>::globals(GlobalRefs& g) {
   ledger_.globals(g);
   if (breaks())
     g("broken_pairs", broken_pairs_);
+  if (releases())
+    g("release_start_time", release_start_);
   boundary_.globals(g);
   if (set_.second_order_window > 0) {
     g("steps", steps_);
@@ -226,6 +230,8 @@ void SolidSolver<Dim, Law>::finish_forces(double t, double dt) {
   st_.work = energy_criterion() ? BondWork::Accumulate : BondWork::Off;
   forces(t + dt);
   trapezoid_half();
+  if (releases())  // the release force's share of the external work (header)
+    w.release_work = 0.5 * (release_factor(t) + release_factor(t + dt)) * release_work(p, du_);
   w.dissipation = dt * damping_power();
   w.pore_work = pore_power();
   keep_applied();
@@ -249,8 +255,8 @@ void SolidSolver<Dim, Law>::complete(double t, double dt, const Breakage& broken
   StepTerms& w = pending_;
   w.broken = double(broken.bonds);
   w.released = broken.energy;
-  static_assert(sizeof(StepTerms) == 7 * sizeof(double));
-  MPI_Allreduce(MPI_IN_PLACE, &w, 7, MPI_DOUBLE, MPI_SUM, comm_);
+  static_assert(sizeof(StepTerms) == 8 * sizeof(double));
+  MPI_Allreduce(MPI_IN_PLACE, &w, 8, MPI_DOUBLE, MPI_SUM, comm_);
   ledger_.book(w);
   advance_velocities(p, st_.force, st_.moment, rho_, inertia_, body_, couple_, set_.gravity,
                      set_.damping, dt);
@@ -305,6 +311,14 @@ void SolidSolver<Dim, Law>::after_breakage(double t, double before) {
         "mupm::Fracture::strain_reference", range(0, p.n_owned),
         KOKKOS_LAMBDA(const std::size_t i) { ref(i) += vs(i) - old(i); });
     forces(t);
+  }
+  if (releases()) {  // the forces continue (header): no jump of the accelerations to book
+    keep_release(t);
+    keep_applied();
+    double after = stored_energy();
+    MPI_Allreduce(MPI_IN_PLACE, &after, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    ledger_.add(&SolidEnergy::fracture, before - after);
+    return;
   }
   keep_applied();
   double after[2] = {stored_energy(), -acceleration_sum(p, rho_, inertia_)};
@@ -394,6 +408,7 @@ void SolidSolver<Dim, Law>::forces(double t) {
     crack_->evaluate();
     add_to_body(crack_->force());
   }
+  add_release(t);
   forces_time_ = t;
   auto eps = st_.eps;
   auto vs = p.vol_strain;
@@ -450,7 +465,56 @@ void SolidSolver<Dim, Law>::restore_applied() {
     body_force_density(boundary_.conditions(), p, disc_.grid.dx, forces_time_, body_, couple_);
     Kokkos::deep_copy(crack_->force(), Kokkos::subview(p.applied_crack_force, owned, Kokkos::ALL));
     add_to_body(crack_->force());
+    add_release(forces_time_);
   }
+}
+
+template <int Dim, class Law>
+double SolidSolver<Dim, Law>::release_factor(double t) const {
+  return std::max(0.0, 1.0 - (t - release_start_) / set_.fracture.release_time);
+}
+
+template <int Dim, class Law>
+void SolidSolver<Dim, Law>::add_release(double t) {
+  if (!releases())
+    return;
+  const double r = release_factor(t);
+  if (r == 0)
+    return;
+  auto b = body_, c = couple_, rel = disc_.points.release_force;
+  Kokkos::parallel_for(
+      "mupm::Solid::add_release", range(0, disc_.points.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i) {
+        for (int k = 0; k < Dim; ++k)
+          b(i, k) += r * rel(i, k);
+        for (int k = 0; k < R; ++k)
+          c(i, k) += r * rel(i, Dim + k);
+      });
+}
+
+// After a break at t (after_breakage): st_ holds the forces of the new bond set, f_old_ and
+// l_old_ those of the old one, body_ and couple_ the release of before the break at r(t).
+template <int Dim, class Law>
+void SolidSolver<Dim, Law>::keep_release(double t) {
+  const double r = release_factor(t);
+  auto rel = disc_.points.release_force;
+  auto f = st_.force, l = st_.moment, f0 = f_old_, l0 = l_old_;
+  auto b = body_, c = couple_;
+  Kokkos::parallel_for(
+      "mupm::Fracture::keep_release", range(0, disc_.points.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i) {
+        for (int k = 0; k < Dim; ++k) {
+          const double d = f0(i, k) - f(i, k);
+          rel(i, k) = r * rel(i, k) + d;
+          b(i, k) += d;
+        }
+        for (int k = 0; k < R; ++k) {
+          const double d = l0(i, k) - l(i, k);
+          rel(i, Dim + k) = r * rel(i, Dim + k) + d;
+          c(i, k) += d;
+        }
+      });
+  release_start_ = t;
 }
 
 template <int Dim, class Law>

@@ -319,6 +319,13 @@ base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" val
 expect j_increment 2 'mupm->J-Integral->Crack Increment' 'exceeds one Spacing'
 base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/><Parameter name="Maximum Crack Speed" type="double" value="10"/>' >j_speed.xml
 expect j_speed 2 'mupm->J-Integral->Maximum Crack Speed' 'Bond Breakage = J-Integral'
+# ... a release time without the J criterion, and one longer than the speed cap's wait
+# (Crack Increment 0.005 m / 10 m/s = 0.5 ms).
+base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/><Parameter name="Release Time" type="double" value="1e-4"/>' >j_release.xml
+expect j_release 2 'mupm->J-Integral->Release Time' 'Bond Breakage = J-Integral'
+base "$crack" '' | jlist '<Parameter name="Half Widths" type="Array(double)" value="{3}"/><Parameter name="Crack Increment" type="double" value="0.005"/><Parameter name="Maximum Crack Speed" type="double" value="10"/><Parameter name="Release Time" type="double" value="6e-4"/>' |
+  sed 's|  <ParameterList name="Solver">|  <ParameterList name="Fracture"><Parameter name="Bond Breakage" type="string" value="J-Integral"/><Parameter name="Critical Energy Release Rate" type="double" value="10"/></ParameterList>\n&|' >j_release_wait.xml
+expect j_release_wait 2 'mupm->J-Integral->Release Time' 'exceeds the speed cap' 'wait'
 # Drucker-Prager: no cohesion, a residual cohesion above the initial one.
 base '' '' | sed 's|<Parameter name="Bulk Modulus"|<Parameter name="Model" type="string" value="Micropolar Drucker-Prager"/>&|' >dp_no_cohesion.xml
 expect dp_no_cohesion 2 'mupm->Materials->Cohesion' 'must be > 0'

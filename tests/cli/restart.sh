@@ -110,6 +110,15 @@ with h5py.File(f"{name}-straight/checkpoint.h5") as a, h5py.File(f"{name}-second
         f["globals"].visititems(lambda k, d: out.__setitem__(k, d[0]) if isinstance(d, h5py.Dataset) else None)
         return out
     ga, gb = named(a), named(b)
+    if "release_force" in a["points"]:  # the J criterion's release: under way at the restart
+        with h5py.File(f"{name}-first/checkpoint.h5") as c:
+            gc = named(c)
+            held = np.abs(c["points"]["release_force"][...]).max()
+        t_b = [v for k, v in gc.items() if k.endswith("release_start_time")]
+        t_half = [float(r["time"]) for r in csv.DictReader(open(f"{name}-first/time_series.csv"))][-1]
+        print("restart %s: the release started at %.4g s, restarted at %.4g s, |F| up to %.3g" %
+              (name, t_b[0], t_half, held))
+        assert len(t_b) == 1 and held > 0 and 0 <= t_half - t_b[0] < 1.25e-4, (t_b, t_half, held)
     assert sorted(ga) == sorted(gb) and len(ga) == globals_, (sorted(ga), sorted(gb))
     for k in ga:
         assert np.allclose(ga[k], gb[k], rtol=1e-11, atol=1e-300), (k, ga[k], gb[k])
@@ -157,6 +166,9 @@ check fracture-flow tests/cli/fracture_small.xml 440 24 "$flow_edit"
 # fracture points before their damage reaches D_cr (kFlagCut), set again from the advances at
 # the restart.
 check fracture-flow-j tests/cli/fracture_small.xml 440 26 "$flow_edit; s|value=\"Energy\"/>|value=\"J-Integral\"/>|; s|  <ParameterList name=\"Boundary Conditions\">|  <ParameterList name=\"J-Integral\"><Parameter name=\"Half Widths\" type=\"Array(double)\" value=\"{4, 5}\"/><Parameter name=\"Crack Increment\" type=\"double\" value=\"0.00125\"/></ParameterList>\n&|"
+# The same with the increments' bond forces released over the speed cap's wait (J-Integral->
+# Release Time; the release field and its start are restored), restarted during a release.
+check fracture-flow-j-release tests/cli/fracture_small.xml 440 27 "$flow_edit; s|value=\"Energy\"/>|value=\"J-Integral\"/>|; s|  <ParameterList name=\"Boundary Conditions\">|  <ParameterList name=\"J-Integral\"><Parameter name=\"Half Widths\" type=\"Array(double)\" value=\"{4, 5}\"/><Parameter name=\"Crack Increment\" type=\"double\" value=\"0.00125\"/><Parameter name=\"Maximum Crack Speed\" type=\"double\" value=\"10\"/><Parameter name=\"Release Time\" type=\"double\" value=\"1.25e-4\"/></ParameterList>\n&|"
 # The same with a drained boundary layer at the notch's face (-x) that the crack runs into, its
 # fracture points held by a mirrored Fracture Pressure (2 g - q, q relaxed from the step's start
 # and rebuilt from the checkpointed p_f: src/solvers/fracture_flow.cpp, assemble).

@@ -26,7 +26,8 @@ enum FieldGroup : unsigned {
   kGroupCrackWater = 1u << 2,  // the crack water (Fracture->Fracture Flow)
   kGroupPlastic = 1u << 3,     // the plastic state (Materials->Model = Micropolar Drucker-Prager)
   kGroupSecondOrderWork = 1u << 4,  // second-order work and its window's start (eq 42)
-  kAllGroups = (1u << 5) - 1,
+  kGroupRelease = 1u << 5,          // the J criterion's release force (J-Integral->Release Time)
+  kAllGroups = (1u << 6) - 1,
 };
 
 struct FieldSpec {

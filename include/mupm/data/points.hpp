@@ -108,13 +108,16 @@ struct Points {
   Vectors plastic_step_start;         // the plastic state and stress at the step's start (law)
   Scalars second_order_work;          // d2E of the last window [N/m^2] (eq 42)
   Vectors second_order_work_start;    // sigma-bar, eps, m, kappa at the window's start
+  Vectors release_force;  // force and moment densities the J criterion's increments release
+                          // [n][Dim + RotDim] (include/mupm/solvers/solid_solver.hpp)
 
   // The registry: f(view, spec) for every field, in this order (the checkpoint's and the
   // output list's). Traits: kConstant (sent to the ghosts once), kGhosted (refreshed on the
   // ghosts at a start and a restart), kCheckpoint, kOutput (selectable in Output->Fields),
   // kFinite (checked for NaN/Inf every step); the fourth argument is the name under which
   // an initial condition sets the field (Initial Conditions->NAME->Field), or nullptr; the fifth
-  // its FieldGroup (W pore water, C crack water, P plastic, S second-order work; else core). Only
+  // its FieldGroup (W pore water, C crack water, P plastic, S second-order work, G the J
+  // criterion's release; else core). Only
   // the fields of the allocated groups are visited.
   template <class F>
   void for_each_field(F&& f) {
@@ -190,7 +193,7 @@ struct Points {
     constexpr int D = Dim, R = rot_dim;
     constexpr unsigned kState = kCheckpoint | kOutput;
     constexpr unsigned W = kGroupPoreWater, C = kGroupCrackWater, P = kGroupPlastic,
-                       S = kGroupSecondOrderWork;
+                       S = kGroupSecondOrderWork, G = kGroupRelease;
     auto f = [&](auto& view, const FieldSpec& s) {
       if (s.group & p.groups)
         fn(view, s);
@@ -248,6 +251,7 @@ struct Points {
     f(p.second_order_work, FieldSpec{"second_order_work", 1, kState, nullptr, S});
     f(p.second_order_work_start, FieldSpec{"second_order_work_start", 2 * (D * D + R * D),
                                            kCheckpoint, nullptr, S});
+    f(p.release_force,     FieldSpec{"release_force", D + R, kCheckpoint, nullptr, G});
     // clang-format on
   }
 };

@@ -47,6 +47,9 @@ struct FractureParams {
   double water_modulus = 2.2e9;  // K_w [Pa] (Fluid->Fluid Bulk Modulus): the crack water's
                                  // stiffness in the solid's stable-step estimate
   bool face_pressure = true;     // p_f on the crack's faces (true) or on fracture bonds (eq 17)
+  // J criterion: the time [s] over which an increment's bond forces fall to zero
+  // (J-Integral->Release Time; 0: at once; include/mupm/solvers/solid_solver.hpp).
+  double release_time = 0;
 };
 
 // W_cr of eq 36 (3D) and its plane-strain analogue (header), per pair of unit volumes.

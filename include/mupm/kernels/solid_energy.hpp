@@ -98,6 +98,27 @@ void external_power(const Points<Dim>& p, const Vectors& f, const Vectors& l, co
       out[0], out[1]);
 }
 
+// sum V (F . du + L . dtheta) over the free components, F and L the J criterion's release force
+// and couple densities (Points::release_force, include/mupm/solvers/solid_solver.hpp) at full
+// strength: times the mean of the step's two release factors, the release force's work.
+template <int Dim>
+double release_work(const Points<Dim>& p, const Vectors& du) {
+  constexpr int N = Dim + kRotDim<Dim>;
+  auto rel = p.release_force, vol = p.volume;
+  auto fixed = p.fixed;
+  double w = 0;
+  Kokkos::parallel_reduce(
+      "mupm::Solid::release_work", range(0, p.n_owned),
+      KOKKOS_LAMBDA(const std::size_t i, double& acc) {
+        const std::uint32_t fx = fixed(i);
+        for (int k = 0; k < N; ++k)
+          if (!(fx & (1u << k)))
+            acc += rel(i, k) * du(i, k) * vol(i);
+      },
+      w);
+  return w;
+}
+
 // Damping power c (rho v.v + J omega.omega) V at the half step.
 template <int Dim>
 double damping_power(const Points<Dim>& p, const Scalars& rho, const Scalars& J, double c) {

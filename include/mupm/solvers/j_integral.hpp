@@ -29,6 +29,9 @@
 // contours, whose edges the field of the last increment has not reached yet, show J >= G_cr.
 // J-Integral->Maximum Crack Speed replaces c_R by a given speed: a quasi-static crack (a
 // hydraulic fracture) waits until the field and the crack water have settled.
+// J-Integral->Release Time releases an increment's bond forces over a time instead of at once
+// (include/mupm/solvers/solid_solver.hpp); the input check keeps it within the wait, so that
+// each J decision sees a released field.
 //
 // Sums over ranks: every point's terms are added exactly (include/mupm/core/exact_sum.hpp), so
 // that J, and with it the criterion's decision, is the same to the last bit on any number of

@@ -83,6 +83,8 @@ struct StepTerms {
   double stored_before = 0;  // [J] strain energy before the breakage (after_breakage)
   double broken = 0;         // directed bonds broken (energy and J criteria)
   double released = 0;       // [J] the bond energy they released (energy criterion)
+  double release_work = 0;   // [J] the J criterion's release force's share of external_work
+                             // (SolidSolver: booked as fracture dissipation, not as W_ext)
 };
 
 class SolidLedger {

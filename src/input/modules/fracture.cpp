@@ -110,7 +110,9 @@ void check_fracture(ParameterList& input) {
 }
 
 unsigned fracture_field_groups(const ParameterList& input) {
-  return input.sublist("Fracture").get<bool>("Fracture Flow") ? unsigned(kGroupCrackWater) : 0u;
+  return (input.sublist("Fracture").get<bool>("Fracture Flow") ? unsigned(kGroupCrackWater) : 0u) |
+         (input.sublist("J-Integral").get<double>("Release Time") > 0 ? unsigned(kGroupRelease)
+                                                                      : 0u);
 }
 
 void declare_j_integral(ParameterList& j) {
@@ -141,6 +143,14 @@ void declare_j_integral(ParameterList& j) {
         "against a closed form) takes a v far above its own speed and far below c_R, so that "
         "the field and the crack water settle after each increment before the next J decision.",
         at_least(0.0));
+  j.set("Release Time", 0.0,
+        "J criterion: the time [s] over which the forces an increment's bonds carried fall "
+        "linearly to zero, applied at the bonds' ends as a decaying force (node release; "
+        "include/mupm/solvers/solid_solver.hpp). 0: at once, as the paper's breakage. A quasi-"
+        "static crack (a hydraulic fracture against a closed form) takes the speed cap's wait "
+        "Delta a / Maximum Crack Speed, so that the new faces open as if the tip ran through "
+        "the increment at that speed; at most that wait.",
+        at_least(0.0));
 }
 
 // J-Integral: 2D, a solid, a pre-crack, matching contour sizes that fit the body at the start.
@@ -154,6 +164,11 @@ void check_j_integral(ParameterList& input, int dim, Physics phys) {
   if (w.empty() && !h.empty())
     throw InputError("Error, " + path_of(j, "Half Heights") + " is given without " +
                      path_of(j, "Half Widths") + ".");
+  if (j.get<double>("Release Time") > 0 && !(criterion && j.get<bool>("Speed Cap")))
+    throw InputError("Error, " + path_of(j, "Release Time") +
+                     " is given, but it releases the J criterion's increments: it needs " +
+                     path_of(fr, "Bond Breakage") + " = J-Integral and " + path_of(j, "Speed Cap") +
+                     " = true (the next J decision waits for the release).");
   if (w.empty()) {
     if (criterion)
       throw InputError("Error, " + path_of(fr, "Bond Breakage") + " = J-Integral needs " +
