@@ -230,8 +230,11 @@ void SolidSolver<Dim, Law>::finish_forces(double t, double dt) {
   st_.work = energy_criterion() ? BondWork::Accumulate : BondWork::Off;
   forces(t + dt);
   trapezoid_half();
-  if (releases())  // the release force's share of the external work (header)
-    w.release_work = 0.5 * (release_factor(t) + release_factor(t + dt)) * release_work(p, du_);
+  if (releases()) {  // the release force's share of the external work (header), if it acts
+    const double r = 0.5 * (release_factor(t) + release_factor(t + dt));
+    if (r > 0)
+      w.release_work = r * release_work(p, du_);
+  }
   w.dissipation = dt * damping_power();
   w.pore_work = pore_power();
   keep_applied();
@@ -312,15 +315,14 @@ void SolidSolver<Dim, Law>::after_breakage(double t, double before) {
         KOKKOS_LAMBDA(const std::size_t i) { ref(i) += vs(i) - old(i); });
     forces(t);
   }
+  keep_applied();
   if (releases()) {  // the forces continue (header): no jump of the accelerations to book
     keep_release(t);
-    keep_applied();
     double after = stored_energy();
     MPI_Allreduce(MPI_IN_PLACE, &after, 1, MPI_DOUBLE, MPI_SUM, comm_);
     ledger_.add(&SolidEnergy::fracture, before - after);
     return;
   }
-  keep_applied();
   double after[2] = {stored_energy(), -acceleration_sum(p, rho_, inertia_)};
   auto a = p.a, al = p.alpha;
   auto f = st_.force, l = st_.moment, f0 = f_old_, l0 = l_old_;
