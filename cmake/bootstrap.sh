@@ -39,12 +39,20 @@ stage set-up
 # The targets the tests run (the tests' CMakeLists: mupm, the GoogleTest binary, the kernels'
 # MPI-free compile check).
 test_targets=(mupm mupm_tests mupm_kernels_free_of_mpi)
+# mupm's objects through ccache (cmake/setup.sh installs it), keyed by paths relative to the
+# clone: a second clone (CI's) compiles only what changed. Trilinos is built without it.
+launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER= -DCMAKE_C_COMPILER_LAUNCHER=)
+if command -v ccache >/dev/null; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR=$root CCACHE_NOHASHDIR=true
+fi
 
 if [[ $what == sanitize ]]; then
   # mupm (not Trilinos) instrumented with AddressSanitizer + UndefinedBehaviorSanitizer. The options
   # reach the MPI ranks: Open MPI passes mpirun's environment to the ranks it starts locally.
   cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMUPM_SANITIZE=ON \
-    -DMUPM_ENABLE_BENCHMARKS=OFF -DCMAKE_PREFIX_PATH="$prefix" >build-configure.log 2>&1 ||
+    -DMUPM_ENABLE_BENCHMARKS=OFF -DCMAKE_PREFIX_PATH="$prefix" "${launcher[@]}" \
+    >build-configure.log 2>&1 ||
     { cat build-configure.log; exit 1; }
   rm -f build-configure.log
   cmake --build build-sanitize -j"$jobs" --target "${test_targets[@]}"
@@ -57,7 +65,8 @@ if [[ $what == sanitize ]]; then
   exit
 fi
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" >build-configure.log 2>&1 ||
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" "${launcher[@]}" \
+  >build-configure.log 2>&1 ||
   { cat build-configure.log; exit 1; }
 rm -f build-configure.log
 case "$what" in

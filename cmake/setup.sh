@@ -21,7 +21,7 @@ log() { printf '[mupm setup] %s\n' "$*" >&2; }
 TRILINOS_VERSION=13.2.0
 PACKAGES=(cmake make g++ pkg-config libopenmpi-dev openmpi-bin libhdf5-openmpi-dev
   libgtest-dev libgmock-dev libbenchmark-dev libblas-dev liblapack-dev libhypre64m-dev
-  python3 python3-matplotlib python3-h5py python3-numpy clang-format)
+  python3 python3-matplotlib python3-h5py python3-numpy clang-format ccache)
 
 # ---------------------------------------------------------------- packages
 install_packages() {
